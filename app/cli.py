@@ -1,0 +1,42 @@
+"""The ``lagrange-lab`` command: ``lagrange-lab serve`` starts the web app with uvicorn.
+
+One command a newcomer can remember; everything else (host, port, workers) has a sane default for
+a laptop, and production runs the same command with ``--host 0.0.0.0 --workers N``.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import uvicorn
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser, separate from main() so tests and docs can inspect it."""
+    parser = argparse.ArgumentParser(
+        prog="lagrange-lab", description="Lagrange Lab: analytical mechanics, step by step."
+    )
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    serve = commands.add_parser("serve", help="start the web app (http://127.0.0.1:8000)")
+    serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    serve.add_argument("--port", type=int, default=8000, help="port to bind (default 8000)")
+    serve.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    serve.add_argument("--reload", action="store_true", help="restart when a source file changes")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the console script and of ``python -m app``; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command != "serve":
+        parser.print_help()
+        return 2
+    if args.workers < 1:
+        parser.error("--workers must be at least 1")
+    if args.reload and args.workers > 1:
+        parser.error("--reload runs a single worker; drop --workers")
+    uvicorn.run(
+        "app.main:app", host=args.host, port=args.port, workers=args.workers, reload=args.reload
+    )
+    return 0

@@ -1,0 +1,139 @@
+"""The one place where errors become HTTP answers, so every 422 has the same shape.
+
+Errors are values with a field path, raised at the edge (the spec, the expression parser, the
+budget) and turned into responses here:
+``{"detail": [{"field": "bodies[0].position[0]", "message": "unknown name 'lenght'"}]}``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+
+from mechanics.budget import BudgetExceeded
+from mechanics.expr import ExprError
+from mechanics.spec import SpecError, field_path
+
+#: pydantic error types that mean "the input is not of this union branch's type at all".
+_MISMATCH_SUFFIXES = ("_type", "_parsing")
+
+
+def register_error_handlers(app: FastAPI) -> None:
+    """Install the handlers on ``app`` (called once, by app.main)."""
+    app.add_exception_handler(SpecError, spec_error)
+    app.add_exception_handler(ExprError, expr_error)
+    app.add_exception_handler(BudgetExceeded, budget_exceeded)
+    app.add_exception_handler(RequestValidationError, request_invalid)
+
+
+def unprocessable(errors: Iterable[dict[str, str]]) -> JSONResponse:
+    """A 422 listing every problem as {field, message}."""
+    detail = [{"field": e["field"], "message": _readable(e["message"])} for e in errors]
+    return JSONResponse({"detail": detail}, status_code=422)
+
+
+async def spec_error(request: Request, exc: SpecError) -> JSONResponse:
+    return unprocessable(exc.errors)
+
+
+async def expr_error(request: Request, exc: ExprError) -> JSONResponse:
+    return unprocessable([{"field": exc.field, "message": exc.message}])
+
+
+async def budget_exceeded(request: Request, exc: BudgetExceeded) -> JSONResponse:
+    """Time is the server's limit (503: try later, or simplify); size is the scene's (422)."""
+    message = f"{exc.kind} budget exceeded: {exc.message}"
+    if exc.kind == "time":
+        return JSONResponse({"detail": message}, status_code=503)
+    return unprocessable([{"field": "scene", "message": message}])
+
+
+async def request_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
+    return unprocessable(request_errors(exc.errors(), exc.body))
+
+
+def request_errors(errors: Iterable[dict[str, Any]], body: Any) -> list[dict[str, str]]:
+    """FastAPI's validation errors as {field, message}, one per problem a person can fix.
+
+    Inside a posted scene the path is relative to the spec (``bodies[0].mass``), the same path the
+    engine's own errors carry, so a client maps every error onto the spec it edits alike.
+    pydantic reports a value that fails a union (an expression is text or a number; a position is
+    a list or a frame position) once per branch; the branches the value's type never fitted are
+    dropped when another branch did fit it, and what remains at one field is said in one message.
+    """
+    walked = []  # (error, path, [(union's loc prefix, this branch rejected the value's type)])
+    for error in errors:
+        loc, document = _relative(list(error.get("loc", ())), body)
+        path, branches = _walk(loc, document)
+        mismatch = str(error.get("type", "")).endswith(_MISMATCH_SUFFIXES)
+        wrong_at = len(loc) - 1 if mismatch else None
+        walked.append((error, path, [(prefix, i == wrong_at) for prefix, i in branches]))
+    fitted = {prefix for _, _, branches in walked for prefix, wrong in branches if not wrong}
+    out: dict[str, list[str]] = {}
+    for error, path, branches in walked:
+        if any(wrong and prefix in fitted for prefix, wrong in branches):
+            continue
+        if error.get("type") == "json_invalid":
+            field, message = "body", f"invalid JSON: {(error.get('ctx') or {}).get('error')}"
+        else:
+            field = field_path(path) or (error.get("ctx") or {}).get("field") or "body"
+            message = error.get("msg", "invalid")
+        if message not in out.setdefault(field, []):
+            out[field].append(message)
+    return [{"field": f, "message": _one_message(m)} for f, m in out.items()]
+
+
+def _relative(loc: list[Any], body: Any) -> tuple[list[Any], Any]:
+    """The loc relative to the posted scene (or the request body), and the document it indexes."""
+    if loc[:1] != ["body"]:
+        return loc, None  # a path or query parameter
+    loc = loc[1:]
+    if loc[:1] == ["scene"] and len(loc) > 1 and isinstance(body, dict):
+        return loc[1:], body.get("scene")
+    return loc, body
+
+
+def _walk(loc: list[Any], document: Any) -> tuple[list[Any], list[tuple[tuple, int]]]:
+    """Split a loc into the real path and the union branches it passed through.
+
+    A part is real when it indexes the value found so far in the document (a key of a dict, an
+    index of a list) or names a field; a part shaped like a type ('float', 'constrained-str',
+    'FramePosition', 'list[...]') that indexes nothing is the label pydantic gives a union branch.
+    Returns the path and, per branch, (loc up to the union, index of the label in loc).
+    """
+    path: list[Any] = []
+    branches: list[tuple[tuple, int]] = []
+    current = document
+    for i, part in enumerate(loc):
+        if isinstance(current, dict) and part in current:
+            current = current[part]
+        elif isinstance(current, list) and isinstance(part, int) and 0 <= part < len(current):
+            current = current[part]
+        elif isinstance(part, str) and _is_branch_label(part):
+            branches.append((tuple(loc[:i]), i))
+            continue
+        else:
+            current = None
+        path.append(part)
+    return path, branches
+
+
+def _is_branch_label(part: str) -> bool:
+    return part[:1].isupper() or "[" in part or "-" in part or part in {"str", "int", "float"}
+
+
+def _one_message(messages: list[str]) -> str:
+    """Several branches' complaints about one value, as one sentence."""
+    prefix = "Input should be "
+    if len(messages) > 1 and all(m.startswith(prefix) for m in messages):
+        return prefix + " or ".join(m.removeprefix(prefix) for m in messages)
+    return "; ".join(messages)
+
+
+def _readable(message: str) -> str:
+    # pydantic prefixes a validator's own words with "Value error, "; the field already says where.
+    return message.removeprefix("Value error, ")

@@ -1,0 +1,122 @@
+"""Runs the derivation steps in order; caching lives here, nowhere else.
+
+Two caches, because the two users differ: the JSON of a built-in scene's derivation is kept in
+memory and on disk (a restarted server, or another worker, answers at once), while the sympy
+objects a simulation compiles from are kept in memory per process.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from mechanics import cache
+from mechanics.expr import to_latex, to_plain
+from mechanics.model import Model, build_model
+from mechanics.scenes import load_scene
+from mechanics.spec import SceneSpec, parse_spec
+from mechanics.steps import Step, Work
+from mechanics.steps.conserved import conserved_quantities
+from mechanics.steps.coords import generalized_coordinates
+from mechanics.steps.energy import energies
+from mechanics.steps.fbd import free_body_diagram
+from mechanics.steps.forces import generalized_forces
+from mechanics.steps.kinematics import kinematics
+from mechanics.steps.lagrange import lagrange_equations
+from mechanics.steps.matrix_form import mass_matrix_form
+
+#: Bump when the derivation's output changes, so stale on-disk entries are never served.
+ENGINE_VERSION = "1"
+
+STEPS = (
+    free_body_diagram,
+    generalized_coordinates,
+    kinematics,
+    energies,
+    generalized_forces,
+    lagrange_equations,
+    mass_matrix_form,
+    conserved_quantities,
+)
+
+
+@dataclass
+class Derivation:
+    """The model, every quantity the steps derived, and the steps as shown."""
+
+    model: Model
+    work: Work
+    steps: list[Step]
+    seconds: float
+
+    def equations(self, fmt: Any) -> dict[str, Any]:
+        """The results in one format (to_plain or to_latex), keyed as the API documents."""
+        m, w = self.model, self.work
+        names = m.coordinate_names
+        eom = {n: f"{fmt(lhs)} = {fmt(Q)}" for n, lhs, Q in zip(names, w.eom_lhs, w.Q, strict=True)}
+        return {
+            "T": fmt(w.T),
+            "V": fmt(w.V),
+            "L": fmt(w.L),
+            "generalized_forces": {n: fmt(Q) for n, Q in zip(names, w.Q, strict=True)},
+            "eom": eom,
+            "mass_matrix": [[fmt(e) for e in row] for row in w.mass_matrix.tolist()],
+            "forcing": [fmt(e) for e in w.forcing],
+            "accelerations": None
+            if w.accelerations is None
+            else {n: fmt(a) for n, a in zip(names, w.accelerations, strict=True)},
+            "conserved": [
+                {"name": c["name"], "coordinate": c["coordinate"], "expression": fmt(c["expr"])}
+                for c in w.conserved
+            ],
+        }
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "scene": self.model.spec.model_dump(mode="json", by_alias=True, exclude_defaults=True),
+            "steps": [s.to_json() for s in self.steps],
+            "equations": self.equations(to_plain),
+            "latex": self.equations(to_latex),
+            "warnings": list(self.work.warnings),
+            "seconds": round(self.seconds, 4),
+        }
+
+
+def derive_model(spec: SceneSpec | dict) -> Derivation:
+    """Build the model and run every step; raises SpecError/ExprError for bad input."""
+    start = time.perf_counter()
+    model = build_model(spec)
+    work = Work(started=start)
+    steps = [step(model, work) for step in STEPS]
+    return Derivation(model, work, steps, time.perf_counter() - start)
+
+
+def derive(spec: SceneSpec | dict) -> dict[str, Any]:
+    """The JSON derivation of any spec (a posted one: the caller runs this under a budget)."""
+    return derive_model(spec).to_json()
+
+
+@functools.lru_cache(maxsize=64)
+def derivation_of_scene(scene_id: str) -> Derivation:
+    """The sympy-level derivation of a built-in scene, once per process."""
+    return derive_model(parse_spec(load_scene(scene_id)))
+
+
+_memory: dict[str, dict[str, Any]] = {}
+
+
+def derive_scene(scene_id: str) -> dict[str, Any]:
+    """A built-in scene's derivation, from memory, then disk, then computed (and stored)."""
+    if scene_id in _memory:
+        return _memory[scene_id]
+    raw = load_scene(scene_id)  # KeyError for an unknown scene, before any work
+    key = cache.key_for({"scene": raw}, ENGINE_VERSION)
+    result = cache.get(key)
+    if result is None:
+        result = derivation_of_scene(scene_id).to_json()
+        cache.put(key, json.loads(json.dumps(result)))
+    _memory[scene_id] = result
+    return result

@@ -1,0 +1,159 @@
+"""The derivation, one module per step of the notes' procedure (IV.A 1–6).
+
+A step is a function ``(model, work) -> Step``: it reads the quantities earlier steps left in
+``work`` (T, V, Q_j, ...) and adds its own, so every quantity is computed exactly once.
+"""
+
+from __future__ import annotations
+
+import functools
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import sympy as sp
+from sympy.physics.vector import Vector
+from sympy.simplify.fu import TR5, TR6, TR10i
+
+from mechanics.expr import to_latex, to_plain
+
+#: Expressions larger than this (count_ops) skip trigsimp: it is the step that can take minutes.
+SIMPLIFY_OPS_BUDGET = 600
+
+
+@dataclass
+class Line:
+    """One displayed equation: a label, its LaTeX and its plain-text form."""
+
+    label: str
+    latex: str
+    plain: str
+
+
+@dataclass
+class Step:
+    id: str
+    title: str
+    text: str
+    lines: list[Line] = field(default_factory=list)
+    data: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "id": self.id,
+            "title": self.title,
+            "text": self.text,
+            "latex": [ln.latex for ln in self.lines],
+            "plain": [ln.plain for ln in self.lines],
+            "labels": [ln.label for ln in self.lines],
+            "data": self.data,
+        }
+
+
+@dataclass
+class Work:
+    """What the steps have derived so far, and what could not be simplified in budget."""
+
+    T: sp.Expr = sp.S.Zero
+    V: sp.Expr = sp.S.Zero
+    L: sp.Expr = sp.S.Zero
+    Q: list[sp.Expr] = field(default_factory=list)
+    eom_lhs: list[sp.Expr] = field(default_factory=list)
+    mass_matrix: sp.Matrix | None = None
+    forcing: sp.Matrix | None = None
+    accelerations: list[sp.Expr] | None = None
+    conserved: list[dict[str, Any]] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    started: float = field(default_factory=time.perf_counter)
+
+
+def tidy(expr: sp.Expr, model: Any = None, *, collect_velocities: bool = True) -> sp.Expr:
+    """Textbook form: trig identities applied, terms grouped by velocity monomial.
+
+    Small pieces are simplified one at a time (the issue's lesson: simplifying a solved q̈ whole
+    is where the minutes go): the expression is split by velocity monomial and each coefficient
+    gets a cheap trig pass. Past the size budget a coefficient is left expanded: still correct,
+    only less pretty.
+    """
+    expr = sp.Integer(expr) if isinstance(expr, int) else expr
+    if expr.is_number:
+        return sp.nsimplify(expr) if expr.is_Float else expr
+    if model is None:
+        return _tidy_symbols(expr, ())
+    to_sym, back = _symbols_for(model)
+    velocities = tuple(to_sym[v] for v in (*model.qdd, *model.qd)) if collect_velocities else ()
+    return _tidy_symbols(expr.xreplace(to_sym), velocities).xreplace(back)
+
+
+def _symbols_for(model: Any) -> tuple[dict, dict]:
+    """q(t), q̇(t), q̈(t) as plain symbols: trig passes run faster on symbols than on functions."""
+    cached = getattr(model, "_tidy_symbols", None)
+    if cached is None:
+        to_sym = {}
+        for i, (q, qd, qdd) in enumerate(zip(model.q, model.qd, model.qdd, strict=True)):
+            assume = {"positive": True} if q.is_positive else {"real": True}
+            to_sym[qdd] = sp.Symbol(f"_qdd{i}", real=True)
+            to_sym[qd] = sp.Symbol(f"_qd{i}", real=True)
+            to_sym[q] = sp.Symbol(f"_q{i}", **assume)
+        cached = (to_sym, {v: k for k, v in to_sym.items()})
+        model._tidy_symbols = cached
+    return cached
+
+
+@functools.lru_cache(maxsize=4096)
+def _tidy_symbols(expr: sp.Expr, velocities: tuple) -> sp.Expr:
+    e = sp.expand(expr)
+    if e == 0:
+        return e
+    if velocities:
+        groups = sp.collect(e, velocities, evaluate=False)
+        if len(groups) > 1 or 1 not in groups:
+            terms = [_trig_pass(c) * m for m, c in groups.items()]
+            return sp.Add(*terms)
+    return _trig_pass(e)
+
+
+def _trig_pass(c: sp.Expr) -> sp.Expr:
+    """sin²+cos² = 1 and products to sums of angles, keeping whichever form is smallest."""
+    c = sp.expand(c)
+    if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
+        return c
+    if c.has(sp.sin, sp.cos):
+        candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
+        candidates += [sp.expand(TR10i(x)) for x in candidates]
+        c = min(candidates, key=lambda x: (sp.count_ops(x), len(str(x))))
+        c = TR10i(c)
+    return sp.factor_terms(sp.factor(c)) if c.is_Add else c
+
+
+def vec_in(vector: Vector, frame_name: str, model: Any) -> tuple[Vector, list[sp.Expr]]:
+    """A vector written along one frame's unit vectors, each component tidied."""
+    frame = model.frame(frame_name)
+    comps = [tidy(vector.dot(u), model) for u in (frame.x, frame.y, frame.z)]
+    out = Vector(0)
+    for c, u in zip(comps, (frame.x, frame.y, frame.z), strict=True):
+        out += c * u
+    return out, comps
+
+
+def vec_line(label_latex: str, vector: Vector, frame_name: str, model: Any, label: str) -> Line:
+    v, comps = vec_in(vector, frame_name, model)
+    names = model.plain_vectors(frame_name)
+    plain_terms = [
+        f"({to_plain(c)})*{n}" if (c.is_Add) else f"{to_plain(c)}*{n}"
+        for c, n in zip(comps, names, strict=True)
+        if c != 0
+    ]
+    plain = " + ".join(plain_terms) if plain_terms else "0"
+    return Line(label, rf"{label_latex} = {to_latex(v) if plain_terms else '0'}", plain)
+
+
+def eq_line(label: str, lhs_latex: str, expr: sp.Expr, lhs_plain: str | None = None) -> Line:
+    return Line(
+        label, f"{lhs_latex} = {to_latex(expr)}", f"{lhs_plain or label} = {to_plain(expr)}"
+    )
+
+
+def q_latex(model: Any, j: int, order: int = 0) -> str:
+    """LaTeX of q_j, its velocity or acceleration, with the dot notation."""
+    return to_latex([model.q, model.qd, model.qdd][order][j])

@@ -1,0 +1,73 @@
+"""Step 8 (notes I, eq. 3–6 and III): energy or the Jacobi integral, and cyclic momenta."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechanics.expr import to_latex, to_plain
+from mechanics.model import Model
+from mechanics.model import T as t
+from mechanics.steps import Line, Step, Work, tidy
+
+
+def explicit_time(expr: sp.Expr, model: Model) -> bool:
+    """Does expr depend on t other than through q(t)? (the coordinates are functions of t)."""
+    dummies = {}
+    for group in (model.qdd, model.qd, model.q):
+        for i, s in enumerate(group):
+            dummies[s] = sp.Dummy(f"d{i}")
+    return expr.subs(dummies).has(t)
+
+
+def conserved_quantities(model: Model, work: Work) -> Step:
+    lines: list[Line] = []
+    found: list[dict] = []
+    no_nc = all(Q == 0 for Q in work.Q)
+    if no_nc and not explicit_time(work.L, model):
+        h = tidy(sum(qd * work.L.diff(qd) for qd in model.qd) - work.L, model)
+        E = tidy(work.T + work.V, model)
+        if tidy(h - E, model) == 0:
+            found.append({"name": "energy", "coordinate": None, "expr": E})
+            lines.append(Line("E", f"E = T + V = {to_latex(E)}", f"E = {to_plain(E)}"))
+        else:
+            found.append({"name": "jacobi", "coordinate": None, "expr": h})
+            lines.append(
+                Line(
+                    "h",
+                    rf"h = \sum_j \dot{{q}}_j \frac{{\partial L}}{{\partial "
+                    rf"\dot{{q}}_j}} - L = {to_latex(h)}",
+                    f"h = {to_plain(h)}",
+                )
+            )
+    for name, qi, qdi, Qj in zip(model.coordinate_names, model.q, model.qd, work.Q, strict=True):
+        if Qj == 0 and tidy(work.L.diff(qi), model) == 0:
+            p = tidy(work.L.diff(qdi), model)
+            found.append({"name": "momentum", "coordinate": name, "expr": p})
+            lines.append(
+                Line(
+                    f"p_{name}",
+                    rf"p_{{{to_latex(qi)}}} = {to_latex(p)}",
+                    f"p_{name} = {to_plain(p)}",
+                )
+            )
+    work.conserved = found
+    parts = []
+    if any(c["name"] == "energy" for c in found):
+        parts.append(
+            "L has no explicit t and no non-conservative force acts, so E = T + V is "
+            "conserved (ΔT + ΔV = 0, notes III)."
+        )
+    elif any(c["name"] == "jacobi" for c in found):
+        parts.append(
+            "The constraints move, so T + V is not conserved, but L has no explicit t: "
+            "the Jacobi integral h = Σ q̇_j ∂L/∂q̇_j − L is."
+        )
+    elif not no_nc:
+        parts.append(
+            "Non-conservative forces do work: dE/dt = Σ Q_j q̇_j, so E changes by W^NC (eq. 23)."
+        )
+    else:
+        parts.append("L depends explicitly on t: neither E nor the Jacobi integral is conserved.")
+    if any(c["name"] == "momentum" for c in found):
+        parts.append("A coordinate absent from L (cyclic) has a conserved momentum p_j = ∂L/∂q̇_j.")
+    return Step("conserved", "Conserved quantities", " ".join(parts), lines)

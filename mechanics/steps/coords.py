@@ -1,0 +1,48 @@
+"""Step 2 (notes I.C, IV.A 2): generalized coordinates, n = 3N − k."""
+
+from __future__ import annotations
+
+from mechanics.expr import to_latex
+from mechanics.model import Model
+from mechanics.steps import Line, Step, Work
+
+
+def generalized_coordinates(model: Model, work: Work) -> Step:
+    """Count the degrees of freedom the coordinates leave after the holonomic constraints."""
+    particles = sum(1 for b in model.bodies if b.kind == "particle")
+    rigid = len(model.bodies) - particles
+    free = 3 * particles + 6 * rigid
+    n = len(model.q)
+    k = free - n
+    count = f"3N = {3 * particles}" if not rigid else f"3·{particles} + 6·{rigid} = {free}"
+    qs = ", ".join(to_latex(q) for q in model.q)
+    text = (
+        f"{len(model.bodies)} bod{'y' if len(model.bodies) == 1 else 'ies'}: {count} coordinates "
+        f"without constraints; the positions below use n = {n} generalized coordinate"
+        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs k = {k} holonomic constraints "
+        "(eq. 12). Each position r_i(q, t) satisfies them for every value of q."
+    )
+    moving = [
+        name
+        for name, f in model.frames.items()
+        if f.angle.has(model.names["t"]) and not any(f.angle.has(q) for q in model.q)
+    ]
+    if moving:
+        text += (
+            f" Moving frame(s) {', '.join(moving)} turn at a prescribed rate: "
+            "the constraints move (rheonomic)."
+        )
+    lines = [
+        Line(
+            "q",
+            rf"\mathbf{{q}} = ({qs}), \quad n = {free} - {k} = {n}",
+            f"q = ({', '.join(model.coordinate_names)}), n = {n}",
+        )
+    ]
+    return Step(
+        "coordinates",
+        "Generalized coordinates",
+        text,
+        lines,
+        {"n": n, "k": k, "coordinates": model.coordinate_names, "moving_frames": moving},
+    )

@@ -1,0 +1,48 @@
+"""Step 4 (notes III, eq. 24–29): kinetic energy T and potential energy V."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechanics.model import Model
+from mechanics.steps import Line, Step, Work, eq_line, tidy
+
+
+def _height_energy(model: Model) -> list[tuple[str, sp.Expr]]:
+    parts = []
+    if model.gravity is not None:
+        g, down = model.gravity
+        for b in model.bodies:
+            parts.append((f"V_{{{b.name}}}", -b.mass * g * b.position.dot(down)))
+    parts += [(f"V_{{{s.name}}}", s.energy) for s in model.springs]
+    parts += [(f"V_{{{name}}}", e) for name, e in model.potentials]
+    return parts
+
+
+def energies(model: Model, work: Work) -> Step:
+    """T = ½ m v·v (+ ½ ω·I_G·ω for rigid bodies); V = m g h + ½ k (ℓ − ℓ0)² + extra potentials."""
+    lines: list[Line] = []
+    T = sp.S.Zero
+    for b in model.bodies:
+        v = model.velocity(b.name)
+        Tb = b.mass * v.dot(v) / 2
+        if b.frame is not None:
+            w = b.frame.ang_vel_in(model.N)
+            Tb += w.dot(b.inertia.dot(w)) / 2
+        Tb = tidy(Tb, model)
+        lines.append(eq_line(f"T_{b.name}", f"T_{{{b.name}}}", Tb))
+        T += Tb
+    V = sp.S.Zero
+    for label, part in _height_energy(model):
+        part = tidy(part, model)
+        lines.append(eq_line(label.replace("{", "").replace("}", ""), label, part))
+        V += part
+    work.T = tidy(T, model)
+    work.V = tidy(V, model)
+    lines += [eq_line("T", "T", work.T), eq_line("V", "V", work.V)]
+    text = (
+        "T = ½ m v·v for each particle (eq. 24) and ½ m v_G·v_G + ½ ω·I_G·ω for each rigid body "
+        "(eq. 25); V sums m g h of each body above the datum (eq. 29), ½ k (ℓ − ℓ₀)² of each "
+        "spring (eq. 27) and any given potential."
+    )
+    return Step("energy", "Kinetic and potential energy", text, lines)

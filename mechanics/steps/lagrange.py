@@ -1,0 +1,59 @@
+"""Step 6 (notes eq. 35–36, IV.A 5–6): L = T − V and the Euler–Lagrange equation per coordinate."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from mechanics.expr import to_latex, to_plain
+from mechanics.model import Model
+from mechanics.model import T as t
+from mechanics.steps import Line, Step, Work, eq_line, tidy
+
+
+def lagrange_equations(model: Model, work: Work) -> Step:
+    """d/dt ∂L/∂q̇_j − ∂L/∂q_j = Q_j^NC, shown piece by piece as the notes do."""
+    work.L = L = tidy(work.T - work.V, model)
+    lines = [eq_line("L", "L = T - V", L, "L")]
+    work.eom_lhs = []
+    for name, qi, qdi, Qj in zip(model.coordinate_names, model.q, model.qd, work.Q, strict=True):
+        ql, qdl = to_latex(qi), to_latex(qdi)
+        p = tidy(L.diff(qdi), model)
+        dp = tidy(p.diff(t), model)
+        dq = tidy(L.diff(qi), model)
+        lhs = tidy(dp - dq, model)
+        work.eom_lhs.append(lhs)
+        lines += [
+            eq_line(
+                f"dL/d{name}_dot", rf"\frac{{\partial L}}{{\partial {qdl}}}", p, f"dL/d{name}_dot"
+            ),
+            eq_line(
+                f"d/dt dL/d{name}_dot",
+                rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial {qdl}}}",
+                dp,
+                f"d/dt dL/d{name}_dot",
+            ),
+            eq_line(f"dL/d{name}", rf"\frac{{\partial L}}{{\partial {ql}}}", dq, f"dL/d{name}"),
+            Line(
+                f"EoM {name}",
+                f"{to_latex(lhs)} = {to_latex(Qj)}",
+                f"{to_plain(lhs)} = {to_plain(Qj)}",
+            ),
+        ]
+    text = (
+        "Form L = T − V (eq. 35). For each coordinate take ∂L/∂q̇_j, its time derivative and "
+        "∂L/∂q_j; the equation of motion is d/dt ∂L/∂q̇_j − ∂L/∂q_j = Q_j^NC (eq. 36)."
+    )
+    return Step("lagrange", "Lagrangian and Euler–Lagrange equations", text, lines)
+
+
+def eom_strings(model: Model, work: Work) -> dict[str, str]:
+    return {
+        name: f"{to_plain(lhs)} = {to_plain(Q)}"
+        for name, lhs, Q in zip(model.coordinate_names, work.eom_lhs, work.Q, strict=True)
+    }
+
+
+def ratio(num: sp.Expr, den: sp.Expr, model: Model) -> sp.Expr:
+    """num/den with common polynomial factors cancelled and each side tidied separately."""
+    n, d = sp.fraction(sp.cancel(sp.factor_terms(num) / sp.factor_terms(den)))
+    return tidy(n, model) / sp.factor(tidy(d, model))

@@ -1,0 +1,55 @@
+"""Step 7: the mass-matrix form M(q, t) q̈ = f(q, q̇, t), and q̈ solved for small systems."""
+
+from __future__ import annotations
+
+import time
+
+import sympy as sp
+
+from mechanics.expr import to_latex, to_plain
+from mechanics.model import Model
+from mechanics.steps import Line, Step, Work, eq_line, tidy
+from mechanics.steps.lagrange import ratio
+
+#: Past this many seconds of derivation, q̈ is left unsolved (the simulation solves M q̈ = f).
+SOLVE_BUDGET_SECONDS = 4.0
+
+
+def mass_matrix_form(model: Model, work: Work) -> Step:
+    """M is linear in q̈ by construction, so M_jk = ∂E_j/∂q̈_k and f = −E|_{q̈=0}."""
+    n = len(model.q)
+    residual = [lhs - Q for lhs, Q in zip(work.eom_lhs, work.Q, strict=True)]
+    M = sp.Matrix(n, n, lambda j, k: tidy(residual[j].diff(model.qdd[k]), model))
+    zero = dict.fromkeys(model.qdd, 0)
+    f = sp.Matrix([tidy(-r.subs(zero), model) for r in residual])
+    work.mass_matrix, work.forcing = M, f
+    lines = [
+        Line("M", rf"\mathbf{{M}} = {to_latex(M)}", f"M = {to_plain(M.tolist())}"),
+        Line("f", rf"\mathbf{{f}} = {to_latex(f)}", f"f = {to_plain(f.T.tolist()[0])}"),
+    ]
+    text = "Collect the q̈ terms: M(q, t) q̈ = f(q, q̇, t); M is symmetric and positive definite."
+    if n <= 3:
+        if time.perf_counter() - work.started > SOLVE_BUDGET_SECONDS:
+            work.warnings.append("q̈ was not solved symbolically: the time budget ran out")
+        else:
+            work.accelerations = solve_accelerations(M, f, model)
+            for name, qdd, acc in zip(
+                model.coordinate_names, model.qdd, work.accelerations, strict=True
+            ):
+                lines.append(eq_line(f"{name}_ddot", to_latex(qdd), acc, f"{name}_ddot"))
+            text += " Solved for q̈ (Cramer's rule, each piece simplified):"
+    return Step("matrix", "Mass-matrix form", text, lines)
+
+
+def solve_accelerations(M: sp.Matrix, f: sp.Matrix, model: Model) -> list[sp.Expr]:
+    """Cramer's rule with a simplified determinant: small pieces instead of simplify(M⁻¹f)."""
+    n = M.shape[0]
+    if n == 1:
+        return [ratio(f[0], M[0, 0], model)]
+    det = tidy(M.det(method="berkowitz"), model, collect_velocities=False)
+    out = []
+    for i in range(n):
+        Mi = M.copy()
+        Mi[:, i] = f
+        out.append(ratio(Mi.det(method="berkowitz"), det, model))
+    return out
