@@ -139,3 +139,86 @@ class DeriveResponse(BaseModel):
     seconds: float | None = Field(
         default=None, description="How long the derivation took when it was computed."
     )
+
+
+class SimulateRequest(DeriveRequest):
+    """Simulate a scene: which one, its parameters and initial state, and how to integrate."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {
+                    "scene_id": "double_pendulum",
+                    "t_end": 20,
+                    "fps": 60,
+                    "method": "DOP853",
+                    "rtol": 1e-10,
+                    "atol": 1e-10,
+                },
+                {"scene_id": "simple_pendulum", "method": "rk4", "dt": 0.01},
+            ]
+        },
+    )
+
+    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
+    initial: dict[str, float] = Field(
+        default={}, description="Initial q and q_dot (`theta`, `theta_dot`); default the scene's."
+    )
+    t_end: float = Field(default=10.0, description="Seconds of motion (≤ 1000).")
+    fps: float = Field(default=60.0, description="Output samples per second (≤ 240).")
+    method: str = Field(
+        default="DOP853",
+        description="euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
+        "RK45, DOP853, Radau, BDF, LSODA (adaptive: rtol, atol).",
+    )
+    rtol: float = Field(default=1e-9, description="Relative tolerance (adaptive methods).")
+    atol: float = Field(default=1e-9, description="Absolute tolerance (adaptive methods).")
+    dt: float | None = Field(default=None, description="Step (fixed-step methods).")
+    check_sensitivity: bool = Field(
+        default=True,
+        description="Re-run at a 1000× looser tolerance and warn if the motion is sensitive.",
+    )
+
+
+class SimulateStats(BaseModel):
+    """What the run cost and how accurate it was."""
+
+    model_config = ConfigDict(extra="allow")
+
+    method: str
+    steps: int
+    rhs_evaluations: int
+    jacobian_evaluations: int
+    wall_time: float = Field(description="Seconds spent integrating.")
+    samples: int
+    status: str = Field(description="ok, or stopped (see warnings).")
+    energy_error: float | None = Field(
+        default=None, description="max |E(t) - E0| / max |T(t)|, when energy is conserved."
+    )
+    jacobi_error: float | None = Field(
+        default=None, description="The same for the Jacobi integral (moving constraints)."
+    )
+    energy_balance_error: float | None = Field(
+        default=None, description="max |E(t) - E0 - W_NC(t)| / max |T(t)|, when forces do work."
+    )
+    momentum_drift: dict[str, float] = Field(
+        description="Relative drift of each conserved momentum p_j."
+    )
+
+
+class SimulateResponse(BaseModel):
+    """A trajectory sampled at the requested rate, its energies, positions and diagnostics."""
+
+    t: list[float]
+    q: dict[str, list[float]]
+    q_dot: dict[str, list[float]]
+    energy: dict[str, list[float]] = Field(description="T, V, E and W_nc along the run.")
+    positions: dict[str, dict[str, list[float]]] = Field(
+        description="x, y, z in N of every body and point, for drawing."
+    )
+    frames: dict[str, list[list[float]]] = Field(
+        description="Per sample, the N components of a frame's x, y, z unit vectors (9 numbers)."
+    )
+    stats: SimulateStats
+    warnings: list[str]

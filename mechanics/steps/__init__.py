@@ -13,7 +13,7 @@ from typing import Any
 
 import sympy as sp
 from sympy.physics.vector import Vector
-from sympy.simplify.fu import TR5, TR6, TR10i
+from sympy.simplify.fu import TR5, TR6, TR8, TR10i
 
 from mechanics.expr import to_latex, to_plain
 
@@ -59,6 +59,8 @@ class Work:
     L: sp.Expr = sp.S.Zero
     Q: list[sp.Expr] = field(default_factory=list)
     eom_lhs: list[sp.Expr] = field(default_factory=list)
+    momenta: list[sp.Expr] = field(default_factory=list)  # ∂L/∂q̇_j
+    dL_dq: list[sp.Expr] = field(default_factory=list)  # ∂L/∂q_j
     mass_matrix: sp.Matrix | None = None
     forcing: sp.Matrix | None = None
     accelerations: list[sp.Expr] | None = None
@@ -108,9 +110,13 @@ def _tidy_symbols(expr: sp.Expr, velocities: tuple) -> sp.Expr:
     if velocities:
         groups = sp.collect(e, velocities, evaluate=False)
         if len(groups) > 1 or 1 not in groups:
-            terms = [_trig_pass(c) * m for m, c in groups.items()]
-            return sp.Add(*terms)
+            total = sp.Add(*(_trig_pass(c) * m for m, c in groups.items()))
+            return min((total, sp.factor_terms(total)), key=_size)
     return _trig_pass(e)
+
+
+def _size(e: sp.Expr) -> tuple[int, int]:
+    return sp.count_ops(e), len(str(e))
 
 
 def _trig_pass(c: sp.Expr) -> sp.Expr:
@@ -121,9 +127,17 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
     if c.has(sp.sin, sp.cos):
         candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
         candidates += [sp.expand(TR10i(x)) for x in candidates]
-        c = min(candidates, key=lambda x: (sp.count_ops(x), len(str(x))))
-        c = TR10i(c)
-    return sp.factor_terms(sp.factor(c)) if c.is_Add else c
+        candidates.append(sp.expand(TR8(c)))
+        c = TR10i(min(candidates, key=_size))
+    if not c.is_Add:
+        return c
+    factored = sp.factor_terms(sp.factor(c))
+    if factored.is_Mul or len(c.args) < 3:
+        return factored
+    # A sum with no common factor may still share one within some terms: k*l0 - k*r = k*(l0 - r).
+    shared = [s for s in c.free_symbols if sum(1 for a in c.args if a.has(s)) >= 2]
+    shapes = [factored] + [sp.collect(c, s) for s in sorted(shared, key=str)[:4]]
+    return min(shapes, key=_size)
 
 
 def vec_in(vector: Vector, frame_name: str, model: Any) -> tuple[Vector, list[sp.Expr]]:

@@ -24,9 +24,9 @@ def conserved_quantities(model: Model, work: Work) -> Step:
     found: list[dict] = []
     no_nc = all(Q == 0 for Q in work.Q)
     if no_nc and not explicit_time(work.L, model):
-        h = tidy(sum(qd * work.L.diff(qd) for qd in model.qd) - work.L, model)
+        h = tidy(sum(qd * p for qd, p in zip(model.qd, work.momenta, strict=True)) - work.L, model)
         E = tidy(work.T + work.V, model)
-        if tidy(h - E, model) == 0:
+        if sp.expand(h - E) == 0 or tidy(h - E, model) == 0:
             found.append({"name": "energy", "coordinate": None, "expr": E})
             lines.append(Line("E", f"E = T + V = {to_latex(E)}", f"E = {to_plain(E)}"))
         else:
@@ -39,9 +39,10 @@ def conserved_quantities(model: Model, work: Work) -> Step:
                     f"h = {to_plain(h)}",
                 )
             )
-    for name, qi, qdi, Qj in zip(model.coordinate_names, model.q, model.qd, work.Q, strict=True):
-        if Qj == 0 and tidy(work.L.diff(qi), model) == 0:
-            p = tidy(work.L.diff(qdi), model)
+    for name, qi, p, dq, Qj in zip(
+        model.coordinate_names, model.q, work.momenta, work.dL_dq, work.Q, strict=True
+    ):
+        if Qj == 0 and dq == 0:
             found.append({"name": "momentum", "coordinate": name, "expr": p})
             lines.append(
                 Line(

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import sympy as sp
 from sympy.physics.vector import Vector
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
-from mechanics.steps import Line, Step, Work, vec_line
+from mechanics.steps import Line, Step, Work, tidy, vec_line
 
 
 def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
@@ -45,7 +44,7 @@ def free_body_diagram(model: Model, work: Work) -> Step:
                     "kind": kind,
                     "plain": lines[-1].plain,
                     "components": [
-                        to_plain(sp.simplify(vec.dot(u))) for u in (model.N.x, model.N.y, model.N.z)
+                        to_plain(tidy(vec.dot(u), model)) for u in (model.N.x, model.N.y, model.N.z)
                     ],
                 }
             )

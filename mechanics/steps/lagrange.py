@@ -22,6 +22,8 @@ def lagrange_equations(model: Model, work: Work) -> Step:
         dq = tidy(L.diff(qi), model)
         lhs = tidy(dp - dq, model)
         work.eom_lhs.append(lhs)
+        work.momenta.append(p)
+        work.dL_dq.append(dq)
         lines += [
             eq_line(
                 f"dL/d{name}_dot", rf"\frac{{\partial L}}{{\partial {qdl}}}", p, f"dL/d{name}_dot"

@@ -1,0 +1,60 @@
+"""``/api/v1/simulate``: integrate a scene's equations of motion with the method the user picks."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from fastapi import APIRouter, Response
+
+from app.derivations import derive_seconds
+from app.routes.scenes import unknown_scene
+from app.schemas import Message, SimulateRequest, SimulateResponse, ValidationErrors
+from mechanics.budget import run_with_budget
+from mechanics.scenes import scene_ids
+from mechanics.spec import parse_spec
+
+router = APIRouter(prefix="/api/v1", tags=["simulate"])
+
+
+@router.post(
+    "/simulate",
+    response_model=SimulateResponse,  # documents the body; the route sends it pre-serialised
+    responses={
+        404: {"model": Message, "description": "Unknown scene_id."},
+        422: {"model": ValidationErrors, "description": "A field is invalid or out of bounds."},
+        503: {"model": Message, "description": "A posted scene ran past its time budget."},
+    },
+    summary="Simulate a scene",
+)
+def post_simulate(request: SimulateRequest) -> Response:
+    """Integrate, then report the trajectory with its cost (steps, RHS evaluations, wall time)
+    and accuracy (energy error or energy balance, momentum drift), and warnings in plain words.
+    """
+    from mechanics.simulate import SimulationRequest, simulate
+
+    options = SimulationRequest(
+        **request.model_dump(include=set(SimulationRequest.__dataclass_fields__))
+    )
+    if request.scene_id is not None:
+        if request.scene_id not in scene_ids():
+            raise unknown_scene(request.scene_id)
+        result = simulate(scene_id=request.scene_id, request=options)
+    else:
+        document = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
+        parse_spec(document)
+        result = run_with_budget(
+            simulate, scene=document, request=options, seconds=derive_seconds()
+        )
+    return Response(content=json.dumps(_finite(result)), media_type="application/json")
+
+
+def _finite(value):
+    """JSON has no NaN/inf: a non-finite number (an overflowing energy) becomes null."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    return value
