@@ -100,9 +100,16 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="what", required=True)
     d = sub.add_parser("derive", help="derivation cost per built-in scene vs sympy")
     d.add_argument("scenes", nargs="*", help="scene ids (default: all)")
+    i = sub.add_parser("integrate", help="work-precision table of the integrators vs a baseline")
+    i.add_argument("scenes", nargs="*", help="scene ids of the problems to run (default: all)")
+    i.add_argument("--html", default="work-precision.html", help="where to write the diagram")
     args = parser.parse_args(argv)
     if args.what == "derive":
         print_derive(bench_derive(args.scenes or scene_ids()))
+    else:
+        from mechanics.bench_integrate import main as integrate_main
+
+        integrate_main(args.scenes, args.html)
     return 0
 
 

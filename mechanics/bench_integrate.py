@@ -1,0 +1,259 @@
+"""``python -m mechanics.bench integrate``: the speed/accuracy trade, measured.
+
+For each scene a reference solution (DOP853 at rtol 1e-13) is computed first; then every method
+at several tolerances (or steps) runs on the same problem and reports wall time, RHS evaluations,
+the error of the final state against the reference and the energy error. Beside them, in the same
+process, runs the baseline a student would write by hand: sympy's LagrangesMethod → `rhs()` →
+`lambdify` (numpy, no cse) → `solve_ivp` with default settings; the table ends with the speed
+ratio at equal accuracy.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+import sympy as sp
+from scipy.integrate import solve_ivp
+
+from mechanics import oracle
+from mechanics.derive import derive_model
+from mechanics.numeric import compile_derivation
+from mechanics.scenes import load_scene
+from mechanics.simulate import SimulationRequest, simulate_compiled
+
+
+@dataclass(frozen=True)
+class Problem:
+    name: str
+    scene: str
+    t_end: float
+    fps: float
+    parameters: dict
+    initial: dict
+
+
+PROBLEMS = (
+    Problem("pendulum 170°", "simple_pendulum", 10.0, 30, {}, {"theta": 170 * np.pi / 180}),
+    Problem(
+        "double pendulum",
+        "double_pendulum",
+        20.0,
+        30,
+        {},
+        {"theta1": 120 * np.pi / 180, "theta2": -10 * np.pi / 180},
+    ),
+    Problem(
+        "stiff spring k/m=1e8",
+        "spring_mass_damper",
+        0.02,
+        5000,
+        {"k": 1e8, "c": 0.0, "F0": 0.0},
+        {"x": 0.01},
+    ),
+    Problem(
+        "Kepler e=0.9",
+        "central_force",
+        2 * np.pi * 10**1.5,
+        2,
+        {},
+        {"r": 1.0, "theta_dot": float(np.sqrt(1.9))},
+    ),
+)
+#: Kepler: a = r_p/(1−e) = 10, so the period is 2π·sqrt(a³/GM) = 2π·10^1.5 ≈ 198.7 s.
+
+SETTINGS = (
+    [("euler", {"dt": h}) for h in (1e-3, 1e-4)]
+    + [("symplectic_euler", {"dt": h}) for h in (1e-3, 1e-4)]
+    + [("rk4", {"dt": h}) for h in (1e-2, 1e-3)]
+    + [("implicit_midpoint", {"dt": h}) for h in (1e-2, 1e-3)]
+    + [
+        (m, {"rtol": r, "atol": r})
+        for m in ("RK45", "DOP853", "dop853_fortran", "Radau", "BDF", "LSODA")
+        for r in (1e-6, 1e-9, 1e-12)
+    ]
+)
+
+
+def _request(p: Problem, method: str, **kw) -> SimulationRequest:
+    return SimulationRequest(
+        parameters=p.parameters,
+        initial=p.initial,
+        t_end=p.t_end,
+        fps=p.fps,
+        method=method,
+        check_sensitivity=False,
+        **kw,
+    )
+
+
+def _final(result: dict, names: list[str]) -> np.ndarray:
+    return np.array([result["q"][n][-1] for n in names])
+
+
+def student_baseline(p: Problem, c, reference: np.ndarray, rtol: float | None) -> dict:
+    """What a student writes: LagrangesMethod → rhs() → lambdify(numpy) → solve_ivp(RK45)."""
+    model = c.derivation.model
+    lm = oracle.lagranges_method(model)
+    rhs_expr = lm.rhs()
+    qs = [sp.Symbol(f"x{i}") for i in range(2 * len(model.q))]
+    swap = dict(
+        zip(list(model.qd) + list(model.q), qs[len(model.q) :] + qs[: len(model.q)], strict=True)
+    )
+    params = [model.params[k] for k in c.parameters]
+    ts = sp.Symbol("t_")
+    f = sp.lambdify(
+        [ts, qs, params], rhs_expr.xreplace(swap).xreplace({model.names["t"]: ts}), modules="numpy"
+    )
+    values = {**model.spec.parameters, **p.parameters}
+    pv = [values[k] for k in c.parameters]
+    init = {**model.spec.initial, **p.initial}
+    y0 = [init.get(n, 0.0) for n in c.coordinates] + [
+        init.get(f"{n}_dot", 0.0) for n in c.coordinates
+    ]
+    t_eval = np.linspace(0, p.t_end, int(p.t_end * p.fps) + 1)
+    kw = {} if rtol is None else {"rtol": rtol, "atol": rtol}
+    start = time.perf_counter()
+    sol = solve_ivp(lambda t, y: f(t, y, pv).ravel(), (0, p.t_end), y0, t_eval=t_eval, **kw)
+    wall = time.perf_counter() - start
+    err = float(np.max(np.abs(sol.y[: len(c.coordinates), -1] - reference)))
+    return {
+        "method": f"student RK45 {'default' if rtol is None else f'rtol {rtol:g}'}",
+        "wall": wall,
+        "nfev": sol.nfev,
+        "error": err,
+        "energy_error": None,
+    }
+
+
+def run_problem(p: Problem) -> list[dict]:
+    spec = load_scene(p.scene)
+    c = compile_derivation(derive_model(spec))
+    ref = simulate_compiled(c, _request(p, "DOP853", rtol=1e-13, atol=1e-13))
+    reference = _final(ref, c.coordinates)
+    rows = []
+    for method, kw in SETTINGS:
+        req = _request(p, method, **kw)
+        if "dt" in kw and p.t_end / kw["dt"] > 400_000:
+            continue  # keeps the whole benchmark to a few minutes
+        if method in ("euler", "symplectic_euler") and p.scene == "spring_mass_damper":
+            req = replace(req, dt=kw["dt"] / 100)  # explicit: the step must resolve ω = 1e4
+        try:
+            res = simulate_compiled(c, req)
+        except Exception as exc:  # a budget refusal is a result too
+            rows.append(
+                {
+                    "method": method,
+                    "setting": kw,
+                    "wall": float("nan"),
+                    "nfev": 0,
+                    "error": float("nan"),
+                    "energy_error": None,
+                    "note": str(exc)[:60],
+                }
+            )
+            continue
+        stats = res["stats"]
+        q_end = _final(res, c.coordinates)
+        err = (
+            float(np.max(np.abs(q_end - reference)))
+            if len(res["t"]) == len(ref["t"])
+            else float("inf")
+        )
+        energy = stats.get("energy_error", stats.get("energy_balance_error"))
+        rows.append(
+            {
+                "method": method,
+                "setting": req.dt if req.dt else req.rtol,
+                "wall": stats["wall_time"],
+                "nfev": stats["rhs_evaluations"],
+                "error": err,
+                "energy_error": energy,
+                "note": stats["status"],
+            }
+        )
+    for rtol in (None, 1e-6, 1e-9):
+        base = student_baseline(p, c, reference, rtol)
+        base["setting"] = "-" if rtol is None else rtol
+        base["note"] = "baseline"
+        rows.append(base)
+    return rows
+
+
+def speedup(rows: list[dict]) -> tuple[float, str] | None:
+    """Best ratio baseline time / our time among our runs at least as accurate as a baseline run."""
+    ours = [r for r in rows if r.get("note") == "ok" and np.isfinite(r["error"])]
+    best = None
+    for b in (r for r in rows if r.get("note") == "baseline"):
+        matching = [r for r in ours if r["error"] <= max(b["error"], 1e-14)]
+        if not matching:
+            continue
+        fastest = min(matching, key=lambda r: r["wall"])
+        ratio = b["wall"] / fastest["wall"]
+        label = (
+            f"{b['method']} (err {b['error']:.1e}) vs {fastest['method']} "
+            f"{fastest['setting']:g} (err {fastest['error']:.1e})"
+        )
+        if best is None or b["error"] < best[2]:
+            best = (ratio, label, b["error"])
+    return None if best is None else (best[0], best[1])
+
+
+def print_table(problem: Problem, rows: list[dict]) -> None:
+    print(f"\n## {problem.name} ({problem.scene}, t_end = {problem.t_end:g} s)")
+    print(
+        f"{'method':<28} {'setting':>9} {'wall ms':>9} {'RHS evals':>10} {'error':>9} "
+        f"{'energy err':>10}"
+    )
+    for r in rows:
+        setting = r["setting"] if isinstance(r["setting"], str) else f"{r['setting']:g}"
+        energy = "-" if r["energy_error"] is None else f"{r['energy_error']:.1e}"
+        print(
+            f"{r['method']:<28} {setting:>9} {r['wall'] * 1e3:9.2f} {r['nfev']:10d} "
+            f"{r['error']:9.1e} {energy:>10}"
+        )
+    s = speedup(rows)
+    if s:
+        print(f"speed-up at equal accuracy: {s[0]:.1f}× — {s[1]}")
+
+
+def write_diagram(results: list[tuple[Problem, list[dict]]], path: str) -> None:
+    """Work–precision diagram: error against wall time, one panel per problem."""
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    fig = make_subplots(rows=1, cols=len(results), subplot_titles=[p.name for p, _ in results])
+    for col, (_, rows) in enumerate(results, start=1):
+        by_method: dict[str, list[dict]] = {}
+        for r in rows:
+            if np.isfinite(r["error"]) and np.isfinite(r["wall"]):
+                by_method.setdefault(r["method"], []).append(r)
+        for method, rs in by_method.items():
+            fig.add_trace(
+                go.Scatter(
+                    x=[r["wall"] for r in rs],
+                    y=[max(r["error"], 1e-16) for r in rs],
+                    mode="lines+markers",
+                    name=method,
+                    legendgroup=method,
+                    showlegend=col == 1,
+                ),
+                row=1,
+                col=col,
+            )
+        fig.update_xaxes(type="log", title_text="wall time (s)", row=1, col=col)
+        fig.update_yaxes(type="log", title_text="final-state error", row=1, col=col)
+    fig.write_html(path, include_plotlyjs=True)
+
+
+def main(scenes: list[str] | None = None, html: str = "work-precision.html") -> None:
+    results = []
+    for p in PROBLEMS:
+        if scenes and p.scene not in scenes:
+            continue
+        rows = run_problem(p)
+        print_table(p, rows)
+        results.append((p, rows))
+    write_diagram(results, html)
+    print(f"\nwork–precision diagram written to {html}")
