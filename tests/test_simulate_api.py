@@ -17,10 +17,10 @@ def post(**body):
 
 
 def test_simple_pendulum_small_angle_period_matches_2pi_sqrt_l_over_g():
-    l, g = 2.0, 9.81
+    length, g = 2.0, 9.81
     r = post(
         scene_id="simple_pendulum",
-        parameters={"l": l, "g": g},
+        parameters={"l": length, "g": g},
         initial={"theta": 0.01},
         t_end=10,
         fps=200,
@@ -37,7 +37,7 @@ def test_simple_pendulum_small_angle_period_matches_2pi_sqrt_l_over_g():
         if theta[i] > 0 >= theta[i + 1]
     ]
     period = crossings[1] - crossings[0]
-    assert period == pytest.approx(2 * math.pi * math.sqrt(l / g), rel=1e-4)
+    assert period == pytest.approx(2 * math.pi * math.sqrt(length / g), rel=1e-4)
     assert body["stats"]["energy_error"] < 1e-8
     assert set(body["energy"]) == {"T", "V", "E", "W_nc"}
     assert len(body["positions"]["bob"]["x"]) == len(t)
