@@ -18,7 +18,7 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model, build_model
 from mechanics.scenes import load_scene
 from mechanics.spec import SceneSpec, parse_spec
-from mechanics.steps import Step, Work
+from mechanics.steps import Step, Work, unsimplified
 from mechanics.steps.conserved import conserved_quantities
 from mechanics.steps.coords import generalized_coordinates
 from mechanics.steps.energy import energies
@@ -90,7 +90,16 @@ def derive_model(spec: SceneSpec | dict) -> Derivation:
     start = time.perf_counter()
     model = build_model(spec)
     work = Work(started=start)
-    steps = [step(model, work) for step in STEPS]
+    token = unsimplified.set([])
+    try:
+        steps = [step(model, work) for step in STEPS]
+        if unsimplified.get():
+            work.warnings.append(
+                f"{len(unsimplified.get())} piece(s) were too large to simplify within the budget "
+                "and are shown expanded: correct, but longer than a textbook would print."
+            )
+    finally:
+        unsimplified.reset(token)
     return Derivation(model, work, steps, time.perf_counter() - start)
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import time
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +20,10 @@ from mechanics.expr import to_latex, to_plain
 
 #: Expressions larger than this (count_ops) skip trigsimp: it is the step that can take minutes.
 SIMPLIFY_OPS_BUDGET = 600
+
+
+#: Pieces left unsimplified because they were over budget, per derivation (per thread/task).
+unsimplified: ContextVar[list] = ContextVar("unsimplified")
 
 
 @dataclass
@@ -124,6 +129,9 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
     """sin²+cos² = 1 and products to sums of angles, keeping whichever form is smallest."""
     c = sp.expand(c)
     if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
+        skipped = unsimplified.get(None)
+        if skipped is not None:
+            skipped.append(c)
         return c
     if c.has(sp.sin, sp.cos):
         candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
