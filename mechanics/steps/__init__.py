@@ -74,7 +74,9 @@ class Work:
     started: float = field(default_factory=time.perf_counter)
 
 
-def tidy(expr: sp.Expr, model: Any = None, *, collect_velocities: bool = True) -> sp.Expr:
+def tidy(
+    expr: sp.Expr, model: Any = None, *, collect_velocities: bool = True, factor_whole: bool = True
+) -> sp.Expr:
     """Textbook form: trig identities applied, terms grouped by velocity monomial.
 
     Small pieces are simplified one at a time (the issue's lesson: simplifying a solved q̈ whole
@@ -86,10 +88,10 @@ def tidy(expr: sp.Expr, model: Any = None, *, collect_velocities: bool = True) -
     if expr.is_number:
         return sp.nsimplify(expr) if expr.is_Float else expr
     if model is None:
-        return _tidy_symbols(expr, ())
+        return _tidy_symbols(expr, (), factor_whole)
     to_sym, back = _symbols_for(model)
     velocities = tuple(to_sym[v] for v in (*model.qdd, *model.qd)) if collect_velocities else ()
-    return _tidy_symbols(expr.xreplace(to_sym), velocities).xreplace(back)
+    return _tidy_symbols(expr.xreplace(to_sym), velocities, factor_whole).xreplace(back)
 
 
 def _symbols_for(model: Any) -> tuple[dict, dict]:
@@ -108,7 +110,7 @@ def _symbols_for(model: Any) -> tuple[dict, dict]:
 
 
 @functools.lru_cache(maxsize=4096)
-def _tidy_symbols(expr: sp.Expr, velocities: tuple) -> sp.Expr:
+def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -> sp.Expr:
     e = sp.expand(expr)
     if e == 0:
         return e
@@ -116,8 +118,23 @@ def _tidy_symbols(expr: sp.Expr, velocities: tuple) -> sp.Expr:
         groups = sp.collect(e, velocities, evaluate=False)
         if len(groups) > 1 or 1 not in groups:
             total = sp.Add(*(_trig_pass(c) * m for m, c in groups.items()))
-            return min((total, sp.factor_terms(total)), key=_size)
+            return min((total, sp.factor_terms(total)), key=_size) if factor_whole else total
     return _trig_pass(e)
+
+
+def _positive_lead(e: sp.Expr) -> sp.Expr:
+    """−R m (g − Ω² R cos θ) sin θ  →  R m (Ω² R cos θ − g) sin θ: move a minus into a sum."""
+    if not e.is_Mul or not e.could_extract_minus_sign():
+        return e
+    sums = [f for f in e.args if f.is_Add]
+    if not sums:
+        return e
+    target = max(sums, key=lambda a: sum(1 for t in a.args if t.could_extract_minus_sign()))
+    negatives = sum(1 for t in target.args if t.could_extract_minus_sign())
+    if 2 * negatives + 1 < len(target.args):
+        return e
+    rest = [f for f in e.args if f is not target]
+    return sp.Mul(*rest) * -1 * sp.expand(-target)
 
 
 def _size(e: sp.Expr) -> tuple[int, int]:
@@ -140,7 +157,7 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
         c = TR10i(min(candidates, key=_size))
     if not c.is_Add:
         return c
-    factored = sp.factor_terms(sp.factor(c))
+    factored = _positive_lead(sp.factor_terms(sp.factor(c)))
     if factored.is_Mul or len(c.args) < 3:
         return factored
     # A sum with no common factor may still share one within some terms: k*l0 - k*r = k*(l0 - r).
@@ -162,13 +179,22 @@ def vec_in(vector: Vector, frame_name: str, model: Any) -> tuple[Vector, list[sp
 def vec_line(label_latex: str, vector: Vector, frame_name: str, model: Any, label: str) -> Line:
     v, comps = vec_in(vector, frame_name, model)
     names = model.plain_vectors(frame_name)
-    plain_terms = [
-        f"({to_plain(c)})*{n}" if (c.is_Add) else f"{to_plain(c)}*{n}"
-        for c, n in zip(comps, names, strict=True)
-        if c != 0
-    ]
-    plain = " + ".join(plain_terms) if plain_terms else "0"
-    return Line(label, rf"{label_latex} = {to_latex(v) if plain_terms else '0'}", plain)
+    plain = ""
+    for c, n in zip(comps, names, strict=True):
+        if c == 0:
+            continue
+        negative = c.could_extract_minus_sign() and not c.is_Add
+        text = to_plain(-c if negative else c)
+        term = f"({text})*{n}" if c.is_Add else f"{text}*{n}"
+        plain += (
+            (" - " if negative else " + ") + term if plain else ("-" if negative else "") + term
+        )
+    return Line(label, rf"{label_latex} = {to_latex(v) if plain else '0'}", plain or "0")
+
+
+def sub(name: str) -> str:
+    """A body or frame name as a LaTeX subscript: upright text when it is a word."""
+    return name if len(name) == 1 else rf"\text{{{name}}}"
 
 
 def eq_line(label: str, lhs_latex: str, expr: sp.Expr, lhs_plain: str | None = None) -> Line:

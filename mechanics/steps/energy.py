@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechanics.model import Model
-from mechanics.steps import Line, Step, Work, eq_line, tidy
+from mechanics.steps import Line, Step, Work, eq_line, sub, tidy
 
 
 def _height_energy(model: Model) -> list[tuple[str, sp.Expr]]:
@@ -13,9 +13,9 @@ def _height_energy(model: Model) -> list[tuple[str, sp.Expr]]:
     if model.gravity is not None:
         g, down = model.gravity
         for b in model.bodies:
-            parts.append((f"V_{{{b.name}}}", -b.mass * g * b.position.dot(down)))
-    parts += [(f"V_{{{s.name}}}", s.energy) for s in model.springs]
-    parts += [(f"V_{{{name}}}", e) for name, e in model.potentials]
+            parts.append((b.name, -b.mass * g * b.position.dot(down)))
+    parts += [(s.name, s.energy) for s in model.springs]
+    parts += [(name, e) for name, e in model.potentials]
     return parts
 
 
@@ -30,12 +30,12 @@ def energies(model: Model, work: Work) -> Step:
             w = b.frame.ang_vel_in(model.N)
             Tb += w.dot(b.inertia.dot(w)) / 2
         Tb = tidy(Tb, model)
-        lines.append(eq_line(f"T_{b.name}", f"T_{{{b.name}}}", Tb))
+        lines.append(eq_line(f"T_{b.name}", f"T_{{{sub(b.name)}}}", Tb))
         T += Tb
     V = sp.S.Zero
-    for label, part in _height_energy(model):
+    for name, part in _height_energy(model):
         part = tidy(part, model)
-        lines.append(eq_line(label.replace("{", "").replace("}", ""), label, part))
+        lines.append(eq_line(f"V_{name}", f"V_{{{sub(name)}}}", part))
         V += part
     work.T = tidy(T, model)
     work.V = tidy(V, model)

@@ -6,7 +6,7 @@ from sympy.physics.vector import Vector
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
-from mechanics.steps import Line, Step, Work, tidy, vec_line
+from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
 
 
 def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
@@ -15,16 +15,20 @@ def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
     if model.gravity is not None:
         g, down = model.gravity
         for b in model.bodies:
-            acting[b.name].append((f"W_{{{b.name}}}", "weight", b.mass * g * down))
+            acting[b.name].append((rf"\vec{{W}}_{{{sub(b.name)}}}", "weight", b.mass * g * down))
     for s in model.springs:
         d = model.positions[s.b] - model.positions[s.a]
         stretch = 1 if s.rest_length == 0 else (s.length - s.rest_length) / s.length
         pull = -s.k * stretch * d
-        acting[s.b].append((f"F_{{{s.name}}}", "spring", pull))
-        acting[s.a].append((f"F_{{{s.name}}}", "spring", -pull))
+        acting[s.b].append((rf"\vec{{F}}_{{{sub(s.name)}}}", "spring", pull))
+        acting[s.a].append((rf"\vec{{F}}_{{{sub(s.name)}}}", "spring", -pull))
     for load in model.loads:
         acting[load.on].append(
-            (f"{'M' if load.kind == 'torque' else 'F'}_{{{load.name}}}", load.kind, load.vector)
+            (
+                rf"\vec{{{'M' if load.kind == 'torque' else 'F'}}}_{{{sub(load.name)}}}",
+                load.kind,
+                load.vector,
+            )
         )
     return acting
 
@@ -37,7 +41,7 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     for b in model.bodies:
         forces = []
         for label, kind, vec in acting[b.name]:
-            lines.append(vec_line(rf"\vec{{{label}}}", vec, "N", model, f"{kind} on {b.name}"))
+            lines.append(vec_line(label, vec, "N", model, f"{kind} on {b.name}"))
             forces.append(
                 {
                     "label": label,

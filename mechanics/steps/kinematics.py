@@ -10,7 +10,7 @@ from __future__ import annotations
 from sympy.physics.vector import Vector
 
 from mechanics.model import Model
-from mechanics.steps import Line, Step, Work, vec_line
+from mechanics.steps import Line, Step, Work, sub, vec_line
 
 
 def kinematics(model: Model, work: Work) -> Step:
@@ -19,7 +19,7 @@ def kinematics(model: Model, work: Work) -> Step:
     for b in model.bodies:
         natural = b.natural_frame
         r = b.position
-        lines.append(vec_line(rf"\vec{{r}}_{{{b.name}}}", r, natural, model, f"r of {b.name}"))
+        lines.append(vec_line(rf"\vec{{r}}_{{{sub(b.name)}}}", r, natural, model, f"r of {b.name}"))
         if natural != "N" and model.frame(natural).ang_vel_in(model.N) != Vector(0):
             frame = model.frame(natural)
             w = frame.ang_vel_in(model.N)
@@ -35,7 +35,7 @@ def kinematics(model: Model, work: Work) -> Step:
             )
             lines.append(
                 vec_line(
-                    rf"\vec{{\omega}}_{{{natural}/N}} \times \vec{{r}}_{{{b.name}}}",
+                    rf"\vec{{\omega}}_{{{natural}/N}} \times \vec{{r}}_{{{sub(b.name)}}}",
                     w.cross(r),
                     natural,
                     model,
@@ -45,13 +45,17 @@ def kinematics(model: Model, work: Work) -> Step:
             transport.append(b.name)
         lines.append(
             vec_line(
-                rf"\vec{{v}}_{{{b.name}}}", model.velocity(b.name), natural, model, f"v of {b.name}"
+                rf"\vec{{v}}_{{{sub(b.name)}}}",
+                model.velocity(b.name),
+                natural,
+                model,
+                f"v of {b.name}",
             )
         )
         if b.frame is not None:
             lines.append(
                 vec_line(
-                    rf"\vec{{\omega}}_{{{b.name}}}",
+                    rf"\vec{{\omega}}_{{{sub(b.name)}}}",
                     b.frame.ang_vel_in(model.N),
                     "N",
                     model,

@@ -20,7 +20,7 @@ def lagrange_equations(model: Model, work: Work) -> Step:
         p = tidy(L.diff(qdi), model)
         dp = tidy(p.diff(t), model)
         dq = tidy(L.diff(qi), model)
-        lhs = tidy(dp - dq, model)
+        lhs = tidy(dp - dq, model, factor_whole=False)  # an EoM reads best term by term
         work.eom_lhs.append(lhs)
         work.momenta.append(p)
         work.dL_dq.append(dq)
