@@ -20,6 +20,8 @@ from mechanics.expr import to_latex, to_plain
 
 #: Expressions larger than this (count_ops) skip trigsimp: it is the step that can take minutes.
 SIMPLIFY_OPS_BUDGET = 600
+#: Up to this size sympy's full trigsimp is affordable (for tan/cot/sec/csc identities).
+SMALL_OPS = 16
 
 
 #: Pieces left unsimplified because they were over budget, per derivation (per thread/task).
@@ -150,6 +152,8 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
         if skipped is not None:
             skipped.append(c)
         return c
+    if c.has(sp.tan, sp.cot, sp.sec, sp.csc) and sp.count_ops(c) <= SMALL_OPS:
+        c = min((c, sp.trigsimp(c)), key=_size)  # small: trigsimp is cheap here
     if c.has(sp.sin, sp.cos):
         candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
         candidates += [sp.expand(TR10i(x)) for x in candidates]
@@ -157,8 +161,10 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
         c = TR10i(min(candidates, key=_size))
     if not c.is_Add:
         return c
+    if len(c.args) < 3:  # a common factor of two terms is all there is to find
+        return _positive_lead(sp.factor_terms(c))
     factored = _positive_lead(sp.factor_terms(sp.factor(c)))
-    if factored.is_Mul or len(c.args) < 3:
+    if factored.is_Mul:
         return factored
     # A sum with no common factor may still share one within some terms: k*l0 - k*r = k*(l0 - r).
     shared = [s for s in c.free_symbols if sum(1 for a in c.args if a.has(s)) >= 2]
