@@ -222,3 +222,42 @@ class SimulateResponse(BaseModel):
     )
     stats: SimulateStats
     warnings: list[str]
+
+
+class CheckRequest(DeriveRequest):
+    """A student's answer for one quantity of a scene's derivation."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {"scene_id": "simple_pendulum", "quantity": "T", "answer": "1/2 m l^2 theta'^2"},
+                {
+                    "scene_id": "cart_pendulum",
+                    "quantity": "eom",
+                    "coordinate": "theta",
+                    "answer": "l theta_ddot + cos(theta) x_ddot + g sin(theta) = 0",
+                    "reveal": True,
+                },
+            ]
+        },
+    )
+
+    quantity: str = Field(description="T, V, L, Q, eom, accel or momentum.")
+    coordinate: str | None = Field(
+        default=None, description="The coordinate, for Q, eom, accel and momentum."
+    )
+    answer: Annotated[str, StringConstraints(max_length=2000)] = Field(
+        description="Plain text; also theta', thetadot, dtheta, ^ for powers, implicit "
+        "multiplication (2 m l^2) and Greek letters (θ)."
+    )
+    reveal: bool = Field(default=False, description="Also return the derived answer.")
+
+
+class CheckResponse(BaseModel):
+    """The verdict and feedback that points at the error."""
+
+    correct: bool
+    feedback: list[str]
+    answer_latex: str = Field(description="What the answer was read as, in LaTeX.")
+    expected_latex: str | None = Field(default=None, description="Only with reveal: true.")

@@ -1,0 +1,140 @@
+"""Student answers as typed (`m l^2 theta'^2/2`, `thetadot`, `θ̇`) -> the strict plain convention.
+
+The rewriting works on tokens, never on evaluated text: Greek letters and primes become names,
+`^` becomes `**`, juxtaposition becomes `*`, and a run of letters that is no known name is split
+into known names when exactly one way exists (`mgl` -> `m*g*l`). The result then goes through the
+same whitelist parser as every other expression, which reports what is still wrong, and where.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+
+from mechanics.expr import FUNCTIONS, MAX_LENGTH, ExprError
+
+GREEK = {
+    "θ": "theta", "ϑ": "theta", "φ": "phi", "ϕ": "phi", "ψ": "psi", "ω": "omega", "Ω": "Omega",
+    "α": "alpha", "β": "beta", "γ": "gamma", "δ": "delta", "μ": "mu", "ρ": "rho", "τ": "tau",
+    "π": "pi", "η": "eta", "ξ": "xi", "ζ": "zeta", "κ": "kappa", "σ": "sigma", "ν": "nu",
+}  # fmt: skip
+SYMBOLS = {"·": "*", "×": "*", "−": "-", "²": "^2", "³": "^3", "½": "(1/2)", "⋅": "*"}
+DOT, DDOT = "\u0307", "\u0308"  # combining dot above / diaeresis: θ̇, θ̈
+
+_TOKEN = re.compile(
+    r"(?P<num>\d+\.?\d*(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?)"
+    r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)"
+    r"|(?P<prime>'+)"
+    r"|(?P<mark>[\u0307\u0308])"
+    r"|(?P<op>\*\*|\^|[-+*/(),=])"
+    r"|(?P<space>\s+)"
+)
+
+
+def _normalise(text: str) -> str:
+    for k, v in {**SYMBOLS, **GREEK}.items():
+        text = text.replace(k, v if k not in GREEK else f" {v}")
+    return text
+
+
+def _velocity_name(name: str, coordinates: set[str], known: set[str]) -> str | None:
+    """thetadot/theta_dot/dtheta -> theta_dot; thetaddot/ddtheta -> theta_ddot."""
+    for suffix, canon in (("_ddot", "_ddot"), ("ddot", "_ddot"), ("_dot", "_dot"), ("dot", "_dot")):
+        if name.endswith(suffix) and name[: -len(suffix)] in coordinates:
+            return name[: -len(suffix)] + canon
+    for prefix, canon in (("dd", "_ddot"), ("d", "_dot")):
+        base = name[len(prefix) :]
+        if name.startswith(prefix) and base in coordinates and name not in known:
+            if "d" in known:
+                raise ExprError(
+                    f"'{name}' is ambiguous here (d*{base} or {base}_dot); write {base}_dot "
+                    f"or d*{base}"
+                )
+            return base + canon
+    return None
+
+
+def _split(name: str, vocabulary: set[str]) -> list[str] | None:
+    """The one way to write `name` as a run of known names, or None (none, or ambiguous)."""
+    ways: list[list[list[str]]] = [[] for _ in range(len(name) + 1)]
+    ways[0] = [[]]
+    for end in range(1, len(name) + 1):
+        for start in range(max(0, end - 24), end):
+            piece = name[start:end]
+            if piece in vocabulary and ways[start]:
+                ways[end] += [w + [piece] for w in ways[start]][:2]
+        ways[end] = ways[end][:2]
+    return ways[-1][0] if len(ways[-1]) == 1 else None
+
+
+def to_convention(
+    text: str, coordinates: Iterable[str], known: Iterable[str], *, field: str = "answer"
+) -> str:
+    """Rewrite a student's text into the strict convention; ExprError says where it cannot."""
+    if not isinstance(text, str):
+        raise ExprError("expected text", field=field)
+    if len(text) > MAX_LENGTH:
+        raise ExprError(f"answer longer than {MAX_LENGTH} characters", field=field)
+    coordinates, known = set(coordinates), set(known)
+    vocabulary = known | set(FUNCTIONS) | {"pi"}
+    text = _normalise(text)
+    out: list[tuple[str, str]] = []  # (kind, text)
+    pos = 0
+    while pos < len(text):
+        m = _TOKEN.match(text, pos)
+        if not m:
+            raise ExprError(f"character {text[pos]!r} is not allowed", field=field, position=pos)
+        pos = m.end()
+        kind = m.lastgroup
+        value = m.group(kind)
+        if kind == "space":
+            continue
+        if kind in ("prime", "mark"):
+            order = len(value) if kind == "prime" else (1 if value == DOT else 2)
+            if not out or out[-1][0] != "name" or out[-1][1] not in coordinates:
+                raise ExprError(
+                    "a prime or dot must follow a coordinate name", field=field, position=m.start()
+                )
+            out[-1] = ("name", out[-1][1] + ("_dot" if order == 1 else "_ddot"))
+            continue
+        if kind == "op" and value == "^":
+            value = "**"
+        if kind == "name":
+            try:
+                pieces = _resolve(value, coordinates, known, vocabulary)
+            except ExprError as exc:
+                raise ExprError(exc.message, field=field, position=m.start()) from None
+            for piece in pieces:
+                _append(out, "name", piece)
+            continue
+        _append(out, kind, value)
+    return " ".join(v for _, v in out)
+
+
+def _resolve(name: str, coordinates: set[str], known: set[str], vocabulary: set[str]) -> list[str]:
+    if name in known or name in FUNCTIONS or name == "pi":
+        return [name]
+    velocity = _velocity_name(name, coordinates, known)
+    if velocity:
+        return [velocity]
+    pieces = _split(name, vocabulary | {f"{q}dot" for q in coordinates})
+    if pieces:
+        return [_velocity_name(p, coordinates, known) or p for p in pieces]
+    return [name]  # the parser reports it as unknown, naming it
+
+
+def _append(out: list[tuple[str, str]], kind: str, value: str) -> None:
+    """Insert the '*' that juxtaposition means (`2 m`, `m l`, `l (`, `) (`), not before calls.
+
+    A function written without parentheses takes the one atom after it: `cos θ` -> cos(theta).
+    """
+    if out and out[-1][0] == "name" and out[-1][1] in FUNCTIONS and kind in ("num", "name"):
+        out += [("op", "("), (kind, value), ("op", ")")]
+        return
+    if out:
+        prev_kind, prev = out[-1]
+        left = prev_kind == "num" or prev == ")" or (prev_kind == "name" and prev not in FUNCTIONS)
+        right = kind in ("num", "name") or value == "("
+        if left and right:
+            out.append(("op", "*"))
+    out.append((kind, value))
