@@ -15,7 +15,7 @@ from fastapi.staticfiles import StaticFiles
 from app import __version__
 from app.errors import register_error_handlers
 from app.paths import STATIC_DIR, mathjax_dir
-from app.routes import check, derive, scenes, simulate
+from app.routes import check, derive, equilibria, scenes, simulate
 from app.schemas import Health
 
 #: A request body past this is refused unread: no honest scene comes near it.
@@ -31,6 +31,7 @@ app.include_router(scenes.router)
 app.include_router(derive.router)
 app.include_router(simulate.router)
 app.include_router(check.router)
+app.include_router(equilibria.router)
 register_error_handlers(app)
 
 _mathjax = mathjax_dir()

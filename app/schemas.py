@@ -261,3 +261,36 @@ class CheckResponse(BaseModel):
     feedback: list[str]
     answer_latex: str = Field(description="What the answer was read as, in LaTeX.")
     expected_latex: str | None = Field(default=None, description="Only with reveal: true.")
+
+
+class EquilibriaRequest(DeriveRequest):
+    """Find the equilibria of a scene at the given parameter values."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={"examples": [{"scene_id": "bead_on_hoop", "parameters": {"Omega": 6}}]},
+    )
+
+    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
+
+
+class Equilibrium(BaseModel):
+    """One equilibrium: where, in closed form when possible, when it exists, and how it moves."""
+
+    q: dict[str, float] = Field(
+        description="Coordinates at the given parameters; angles in (−π, π]."
+    )
+    symbolic: dict[str, str] = Field(
+        description="Closed form per coordinate, where sympy found it."
+    )
+    free: list[str] = Field(description="Coordinates absent from the conditions (any value).")
+    exists_when: str = Field(description="Condition for existence, e.g. |g/(Omega**2*R)| <= 1.")
+    stable: bool
+    frequencies: list[float] = Field(description="Small-oscillation ω in rad/s, ascending.")
+    modes: list[list[float]] = Field(description="Normal mode shapes, one per frequency.")
+
+
+class EquilibriaResponse(BaseModel):
+    steps: list[Step]
+    equilibria: list[Equilibrium]
+    warnings: list[str]

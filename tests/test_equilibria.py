@@ -1,0 +1,95 @@
+"""Equilibria, stability and normal modes against closed forms (notes II.A; small oscillations)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from app.main import app
+
+client = TestClient(app)
+
+
+def post(**body):
+    r = client.post("/api/v1/equilibria", json=body)
+    assert r.status_code == 200, r.text
+    return r.json()
+
+
+def at(result, **q):
+    for e in result["equilibria"]:
+        if all(math.isclose(e["q"][k], v, abs_tol=1e-9) for k, v in q.items()):
+            return e
+    raise AssertionError(f"no equilibrium at {q}: {[e['q'] for e in result['equilibria']]}")
+
+
+def test_pendulum_hangs_stably_with_omega_squared_g_over_l():
+    g, length = 9.81, 2.0
+    r = post(scene_id="simple_pendulum", parameters={"g": g, "l": length})
+    down, up = at(r, theta=0.0), at(r, theta=math.pi)
+    assert down["stable"] and not up["stable"]
+    assert down["frequencies"] == pytest.approx([math.sqrt(g / length)], rel=1e-12)
+    assert [s["id"] for s in r["steps"]] == ["virtual_work", "stability"]
+
+
+def test_coupled_oscillators_modes_k_over_m_and_3k_over_m():
+    k, m = 4.0, 0.5
+    r = post(scene_id="coupled_oscillators", parameters={"k": k, "k12": k, "m": m})
+    (e,) = r["equilibria"]
+    assert e["frequencies"] == pytest.approx([math.sqrt(k / m), math.sqrt(3 * k / m)], rel=1e-12)
+    in_phase, out_of_phase = (np.array(v) for v in e["modes"])
+    assert abs(in_phase[0] / in_phase[1] - 1) < 1e-12
+    assert abs(out_of_phase[0] / out_of_phase[1] + 1) < 1e-12
+
+
+@pytest.mark.parametrize("omega", [6.0, 8.0])
+def test_hoop_off_axis_equilibrium_exists_above_critical_spin(omega):
+    g, R = 9.81, 0.5
+    r = post(scene_id="bead_on_hoop", parameters={"Omega": omega, "g": g, "R": R})
+    bottom = at(r, theta=0.0)
+    assert not bottom["stable"]  # Ω² > g/R: the bottom is unstable
+    theta0 = math.acos(g / (R * omega**2))
+    for sign in (1, -1):
+        e = at(r, theta=sign * theta0)
+        assert e["stable"]
+        assert "acos" in e["symbolic"]["theta"] and "<= 1" in e["exists_when"]
+        w2 = omega**2 - g**2 / (R**2 * omega**2)
+        assert e["frequencies"] == pytest.approx([math.sqrt(w2)], rel=1e-10)
+
+
+def test_hoop_below_critical_spin_has_stable_bottom_with_g_over_r_minus_omega_squared():
+    g, R, omega = 9.81, 0.5, 3.0
+    r = post(scene_id="bead_on_hoop", parameters={"Omega": omega, "g": g, "R": R})
+    assert sorted(round(e["q"]["theta"], 9) for e in r["equilibria"]) == [0.0, round(math.pi, 9)]
+    assert at(r, theta=0.0)["frequencies"] == pytest.approx([math.sqrt(g / R - omega**2)])
+
+
+def test_free_cart_moves_with_its_pendulum():
+    """Cart free on its track: ω² = (g/l)(M + m)/M, not g/l."""
+    M, m, g, length = 1.0, 0.5, 9.81, 1.0
+    r = post(scene_id="cart_pendulum", parameters={"F": 0.0, "M": M, "m": m, "g": g, "l": length})
+    e = at(r, theta=0.0)
+    assert e["free"] == ["x"]
+    assert e["frequencies"] == pytest.approx([math.sqrt(g / length * (M + m) / M)])
+
+
+def test_no_equilibrium_and_drives_are_explained():
+    assert post(scene_id="central_force")["equilibria"] == []
+    driven = post(scene_id="spring_mass_damper")
+    assert driven["equilibria"] == [] and "time" in driven["warnings"][0]
+    undriven = post(scene_id="spring_mass_damper", parameters={"F0": 0.0})
+    assert at(undriven, x=0.0)["stable"]
+
+
+def test_bad_parameters_are_422():
+    r = client.post(
+        "/api/v1/equilibria", json={"scene_id": "simple_pendulum", "parameters": {"m": -1}}
+    )
+    assert r.status_code == 422 and r.json()["detail"][0]["field"] == "parameters.m"
+    r = client.post(
+        "/api/v1/equilibria", json={"scene_id": "simple_pendulum", "parameters": {"nope": 1}}
+    )
+    assert r.status_code == 422
