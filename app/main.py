@@ -15,7 +15,7 @@ from fastapi.staticfiles import StaticFiles
 from app import __version__
 from app.errors import register_error_handlers
 from app.paths import STATIC_DIR, mathjax_dir
-from app.routes import check, derive, equilibria, scenes, simulate
+from app.routes import check, derive, equilibria, newton, scenes, simulate
 from app.schemas import Health
 
 #: A request body past this is refused unread: no honest scene comes near it.
@@ -32,6 +32,7 @@ app.include_router(derive.router)
 app.include_router(simulate.router)
 app.include_router(check.router)
 app.include_router(equilibria.router)
+app.include_router(newton.router)
 register_error_handlers(app)
 
 _mathjax = mathjax_dir()

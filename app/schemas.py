@@ -179,6 +179,10 @@ class SimulateRequest(DeriveRequest):
         default=True,
         description="Re-run at a 1000× looser tolerance and warn if the motion is sensitive.",
     )
+    constraint_forces: bool = Field(
+        default=False,
+        description="Also return the constraint force on each body (and a rod's tension).",
+    )
 
 
 class SimulateStats(BaseModel):
@@ -222,6 +226,13 @@ class SimulateResponse(BaseModel):
     )
     stats: SimulateStats
     warnings: list[str]
+    work: dict[str, dict[str, list[float]]] = Field(
+        description="Cumulative work since t = 0 of each conservative force (−ΔV of its part) "
+        "and each non-conservative one (∫F·v dt), keyed 'kind:name'."
+    )
+    constraint_forces: dict[str, dict[str, list[float]]] | None = Field(
+        default=None, description="With constraint_forces: true — R in N (x, y, z), tension."
+    )
 
 
 class CheckRequest(DeriveRequest):
@@ -294,3 +305,26 @@ class EquilibriaResponse(BaseModel):
     steps: list[Step]
     equilibria: list[Equilibrium]
     warnings: list[str]
+
+
+class ConstraintForceOut(BaseModel):
+    """The force a constraint supplies to one body, with q̈ from the equations of motion."""
+
+    body: str
+    frame: str = Field(description="The frame its components are written in.")
+    unit_vectors: list[str]
+    components: list[str]
+    latex: str
+    tension_toward: str | None = Field(
+        description="The point it hangs from by a rod or string of fixed length, if any."
+    )
+    tension: str | None = Field(description="The pull toward that point (negative: a push).")
+
+
+class NewtonResponse(BaseModel):
+    """Σ F = m a (and Σ M = dH/dt) beside Lagrange: steps, constraint forces, agreement."""
+
+    steps: list[Step]
+    constraint_forces: list[ConstraintForceOut]
+    equations: dict[str, str] = Field(description="Newton's equations projected on each δq_j.")
+    agrees_with_lagrange: bool

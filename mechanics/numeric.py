@@ -14,9 +14,11 @@ from typing import Any
 
 import numpy as np
 import sympy as sp
+from sympy.physics.vector import Vector
 
 from mechanics.derive import Derivation, derivation_of_scene, derive_model
 from mechanics.model import T as t
+from mechanics.steps.energy import potential_parts
 
 
 def _sign(x: float) -> float:
@@ -41,6 +43,8 @@ class CompiledScene:
     jacobi: Any | None  # arrays: h, when the Jacobi integral (not E) is conserved
     momenta: dict[str, Any]  # arrays: conserved p_j of cyclic coordinates
     mass_matrix: Any  # arrays or scalars: -> M flat (for the singularity check)
+    powers: dict[str, Any]  # arrays: power F·v of each non-conservative force (or M·ω)
+    potential_parts: dict[str, Any]  # arrays: each conservative force's share of V
     places: dict[str, Any]  # arrays: -> (x, y, z) of each point/body
     frames: dict[str, Any]  # arrays: -> 9 components of the frame's axes in N
     solved: bool  # True: q̈ from the symbolic solution; False: M q̈ = f solved numerically
@@ -110,6 +114,19 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         accel_and_power = sp.lambdify(args, _plain(power, subs), modules=_MATH, cse=True)
         mass_and_forcing = scalar([*w.mass_matrix, *w.forcing])
     jacobi = next((c["expr"] for c in w.conserved if c["name"] == "jacobi"), None)
+    powers = {}
+    for load in m.loads:
+        if load.kind == "torque":
+            body = next(b for b in m.bodies if b.name == load.on)
+            rate = body.frame.ang_vel_in(m.N)
+        else:
+            rate = m.velocity(load.on)
+        if rate == Vector(0):
+            continue  # a force on a fixed point (a damper's wall end) does no work
+        key = f"{load.kind}:{load.name}" + (f"@{load.on}" if load.kind == "damper" else "")
+        powers[key] = powers.get(key, sp.S.Zero) + load.vector.dot(rate)
+    powers = {k: vector([p]) for k, p in powers.items()}
+    parts = {f"{kind}:{name}": vector([e]) for kind, name, e in potential_parts(m)}
     places = {
         name: vector([r.dot(u) for u in (m.N.x, m.N.y, m.N.z)]) for name, r in m.positions.items()
     }
@@ -130,10 +147,34 @@ def compile_derivation(d: Derivation) -> CompiledScene:
             c["coordinate"]: vector([c["expr"]]) for c in w.conserved if c["name"] == "momentum"
         },
         mass_matrix=vector(list(w.mass_matrix)),
+        powers=powers,
+        potential_parts=parts,
         places=places,
         frames=frames,
         solved=solved,
     )
+
+
+def constraint_force_functions(c: CompiledScene) -> dict[str, tuple[Any, Any | None]]:
+    """Per body: R in N components, and the rod tension when there is one (compiled on demand:
+    Newton's method costs seconds for a double pendulum, and most runs never ask)."""
+    cached = getattr(c, "_constraint_forces", None)
+    if cached is None:
+        from mechanics.newton import newton
+
+        m = c.derivation.model
+        args, subs = _args(c.derivation)
+        _, forces, _ = newton(c.derivation)
+        cached = {}
+        for f in forces:
+            comps = [_plain(f.vector.dot(u), subs) for u in (m.N.x, m.N.y, m.N.z)]
+            fn = sp.lambdify(args, comps, modules=_NUMPY, cse=True)
+            tension = None
+            if f.support is not None:
+                tension = sp.lambdify(args, [_plain(f.support[1], subs)], modules=_NUMPY)
+            cached[f.body] = (fn, tension)
+        c._constraint_forces = cached
+    return cached
 
 
 @functools.lru_cache(maxsize=64)

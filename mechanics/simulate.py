@@ -14,9 +14,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from scipy.integrate import cumulative_simpson
 
 from mechanics.integrators import METHODS, integrate
-from mechanics.numeric import CompiledScene, compiled_scene, compiled_spec, evaluate
+from mechanics.numeric import (
+    CompiledScene,
+    compiled_scene,
+    compiled_spec,
+    constraint_force_functions,
+    evaluate,
+)
 from mechanics.spec import SpecError
 
 MAX_T_END = 1000.0
@@ -39,6 +46,7 @@ class SimulationRequest:
     atol: float = 1e-9
     dt: float | None = None
     check_sensitivity: bool = True
+    constraint_forces: bool = False
 
 
 def _fail(field_: str, message: str) -> SpecError:
@@ -173,7 +181,13 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     frames = {
         name: np.stack(evaluate(fn, t, q, qd, params), axis=1) for name, fn in c.frames.items()
     }
+    work = _work(c, t, q, qd, params)
+    extra: dict[str, Any] = {}
+    if req.constraint_forces:
+        extra["constraint_forces"] = _constraint_forces(c, t, q, qd, params, warnings)
     return {
+        **extra,
+        "work": work,
         "t": t.tolist(),
         "q": {name: q[i].tolist() for i, name in enumerate(c.coordinates)},
         "q_dot": {name: qd[i].tolist() for i, name in enumerate(c.coordinates)},
@@ -183,6 +197,45 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         "stats": stats,
         "warnings": warnings,
     }
+
+
+def _work(c, t, q, qd, params) -> dict[str, dict[str, list[float]]]:
+    """Cumulative work of each force since t = 0 (notes eq. 22–23).
+
+    A conservative force's work is −ΔV of its part of V, exactly; a non-conservative force's is
+    the integral of its power F·v over the samples (cumulative Simpson, so it is as accurate as
+    the output rate allows; the run's W_nc is the exact one, integrated with the motion).
+    """
+    out: dict[str, dict[str, list[float]]] = {"conservative": {}, "non_conservative": {}}
+    for name, fn in c.potential_parts.items():
+        (v,) = evaluate(fn, t, q, qd, params)
+        out["conservative"][name] = (-(v - v[0])).tolist()
+    for name, fn in c.powers.items():
+        (p,) = evaluate(fn, t, q, qd, params)
+        if len(t) >= 3:
+            w = np.concatenate([[0.0], cumulative_simpson(p, x=t)])
+        else:
+            w = np.concatenate([[0.0], np.cumsum(np.diff(t) * (p[1:] + p[:-1]) / 2)])
+        out["non_conservative"][name] = w.tolist()
+    return out
+
+
+def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, list[float]]]:
+    """R = m a − ΣF along the run; a rod's tension, and where a string would go slack."""
+    out = {}
+    for body, (fn, tension_fn) in constraint_force_functions(c).items():
+        x, y, z = evaluate(fn, t, q, qd, params)
+        out[body] = {"x": x.tolist(), "y": y.tolist(), "z": z.tolist()}
+        if tension_fn is not None:
+            (tension,) = evaluate(tension_fn, t, q, qd, params)
+            out[body]["tension"] = tension.tolist()
+            slack = np.nonzero(tension < 0)[0]
+            if len(slack):
+                warnings.append(
+                    f"The tension on {body} turns negative at t = {t[slack[0]]:.3g} s: a rod "
+                    "pushes there, but a string would go slack and the motion would change."
+                )
+    return out
 
 
 def _singularity_warnings(c, t, q, qd, params) -> list[str]:

@@ -157,7 +157,7 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
     if c.has(sp.sin, sp.cos):
         candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
         candidates += [sp.expand(TR10i(x)) for x in candidates]
-        candidates.append(sp.expand(TR8(c)))
+        candidates += [sp.expand(TR8(c)), sp.expand(sp.expand_trig(c))]
         c = TR10i(min(candidates, key=_size))
     if not c.is_Add:
         return c

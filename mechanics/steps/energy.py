@@ -8,14 +8,15 @@ from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, eq_line, sub, tidy
 
 
-def _height_energy(model: Model) -> list[tuple[str, sp.Expr]]:
+def potential_parts(model: Model) -> list[tuple[str, str, sp.Expr]]:
+    """(kind, name, V part): each conservative force's share of V, datum at O."""
     parts = []
     if model.gravity is not None:
         g, down = model.gravity
         for b in model.bodies:
-            parts.append((b.name, -b.mass * g * b.position.dot(down)))
-    parts += [(s.name, s.energy) for s in model.springs]
-    parts += [(name, e) for name, e in model.potentials]
+            parts.append(("weight", b.name, -b.mass * g * b.position.dot(down)))
+    parts += [("spring", s.name, s.energy) for s in model.springs]
+    parts += [("potential", name, e) for name, e in model.potentials]
     return parts
 
 
@@ -33,7 +34,7 @@ def energies(model: Model, work: Work) -> Step:
         lines.append(eq_line(f"T_{b.name}", f"T_{{{sub(b.name)}}}", Tb))
         T += Tb
     V = sp.S.Zero
-    for name, part in _height_energy(model):
+    for _, name, part in potential_parts(model):
         part = tidy(part, model)
         lines.append(eq_line(f"V_{name}", f"V_{{{sub(name)}}}", part))
         V += part

@@ -1,0 +1,190 @@
+"""Newton's method beside Lagrange's (notes I.A): Σ F = m a per particle, constraint forces kept.
+
+Each particle's balance m a = F + R is written along the unit vectors of the frame its position
+is natural in (polar for a pendulum). The constraint force R is the unknown Lagrange never needs:
+projected on the directions the particle may move (∂r/∂q_j) the balances give back the equations
+of motion (D'Alembert, eq. 19–20); projected on the other directions they give R itself, here
+solved with q̈ from the equations of motion: the tension T(θ, θ̇) of a pendulum, the normal force
+of a hoop, the tension of the Atwood machine's string.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import sympy as sp
+from sympy.physics.vector import Vector
+
+from mechanics.derive import Derivation
+from mechanics.expr import to_latex, to_plain
+from mechanics.steps import Line, Step, sub, tidy, vec_in, vec_line
+from mechanics.steps.fbd import body_forces
+
+
+@dataclass
+class ConstraintForce:
+    body: str
+    frame: str
+    vector: Vector  # R = m a − ΣF, with q̈ from the equations of motion
+    components: list[sp.Expr]  # along the natural frame's unit vectors
+    support: tuple[str, sp.Expr] | None = None  # (point, tension toward it) for a rod or string
+
+
+def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Expr]]:
+    """Steps, the constraint force on every particle, and the equations Newton's method gives."""
+    m = d.model
+    acting = body_forces(m)
+    solved = dict(zip(m.qdd, _accelerations(d), strict=True))
+    balance_lines: list[Line] = []
+    forces: list[ConstraintForce] = []
+    residual = [sp.S.Zero] * len(m.q)  # Σ_i (m a_i − F_i)·∂r_i/∂q_j, torques included
+    extra_V = sum((e for _, e in m.potentials), sp.S.Zero)
+    potential_force = _potential_force(m, extra_V)
+    if potential_force is None:  # which body feels it is not declared: R stays unknown
+        for j, q in enumerate(m.q):  # but its virtual work −∂V/∂q_j is
+            residual[j] += extra_V.diff(q)
+    for b in m.bodies:
+        a = m.velocity(b.name).dt(m.N)
+        applied = sum((vec for _, kind, vec in acting[b.name] if kind != "torque"), Vector(0))
+        if potential_force is not None:
+            applied += potential_force
+        frame = b.natural_frame
+        balance_lines.append(
+            vec_line(rf"m\vec{{a}}_{{{sub(b.name)}}}", b.mass * a, frame, m, f"m a of {b.name}")
+        )
+        balance_lines.append(
+            vec_line(
+                rf"\sum\vec{{F}}_{{{sub(b.name)}}}",
+                applied,
+                frame,
+                m,
+                f"applied forces on {b.name}",
+            )
+        )
+        R = b.mass * a - applied
+        for j, q in enumerate(m.q):
+            residual[j] += R.dot(b.position.diff(q, m.N))
+        R_solved = sum(
+            (c.xreplace(solved) * u for c, u in _components(R, m.frame(frame))), Vector(0)
+        )
+        R_nice, comps = vec_in(R_solved, frame, m)
+        if potential_force is not None:
+            support = _support_force(b, R_nice, m)
+            forces.append(ConstraintForce(b.name, frame, R_nice, comps, support))
+        if b.frame is not None:  # Σ M_G = dH_G/dt (eq. 11); the constraint moment is the rest
+            omega = b.frame.ang_vel_in(m.N)
+            dH = b.inertia.dot(omega).dt(m.N)
+            torques = [ld.vector for ld in m.loads if ld.kind == "torque" and ld.on == b.name]
+            torque = sum(torques, Vector(0))
+            balance_lines.append(
+                vec_line(r"\frac{d\vec{H}_{G}}{dt}", dH, "N", m, f"dH/dt of {b.name}")
+            )
+            for j, qd in enumerate(m.qd):
+                residual[j] += (dH - torque).dot(omega.diff(qd, m.N))
+    return _steps(d, balance_lines, forces), forces, [tidy(r, m) for r in residual]
+
+
+def _potential_force(m: Any, V: sp.Expr) -> Vector | None:
+    """−∇V of a given potential, for a scene of one body (the only one it can act on).
+
+    Only its part along the directions the body may move is fixed by V(q):
+    F = −Σ_j c_j ∂r/∂q_j with (JᵀJ) c = ∂V/∂q; any normal part is one with the constraint force.
+    """
+    if V == 0:
+        return Vector(0)
+    if len(m.bodies) != 1:
+        return None
+    r = m.bodies[0].position
+    J = [r.diff(q, m.N) for q in m.q]
+    gram = sp.Matrix(len(J), len(J), lambda i, k: tidy(J[i].dot(J[k]), m))
+    c = gram.LUsolve(sp.Matrix([V.diff(q) for q in m.q]))
+    return sum((-tidy(ci, m) * Ji for ci, Ji in zip(c, J, strict=True)), Vector(0))
+
+
+def _support_force(b: Any, R: Vector, m: Any) -> tuple[str, sp.Expr] | None:
+    """Tension toward the point a body hangs from, when the distance to it is fixed (a rod)."""
+    hangers = [
+        x for x in [*m.spec.bodies, *m.spec.points] if getattr(x.position, "from_", None) == b.name
+    ]
+    if hangers:  # another body pulls on it too: R is not one rod's tension
+        return None
+    spec_body = next(x for x in m.spec.bodies if x.name == b.name)
+    anchor = getattr(spec_body.position, "from_", None) or "O"
+    rel = b.position - m.positions[anchor]
+    length2 = tidy(rel.dot(rel), m)
+    if length2 == 0 or any(length2.has(q) for q in m.q) or length2.has(sp.Symbol("t")):
+        return None
+    tension = tidy(-R.dot(rel) / sp.sqrt(length2), m)
+    return anchor, tension
+
+
+def _components(v: Vector, frame) -> list[tuple[sp.Expr, Vector]]:
+    return [(v.dot(u), u) for u in (frame.x, frame.y, frame.z)]
+
+
+def _accelerations(d: Derivation) -> list[sp.Expr]:
+    if d.work.accelerations is not None:
+        return d.work.accelerations
+    return list(d.work.mass_matrix.LUsolve(d.work.forcing))
+
+
+def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -> list[Step]:
+    m = d.model
+    text = (
+        "For each particle write Σ F = m a (eq. 10) along the unit vectors of its natural "
+        "frame, with the constraint force R as an unknown: m a = ΣF_applied + R."
+    )
+    constraint_lines = []
+    for f in forces:
+        line = vec_line(
+            rf"\vec{{R}}_{{{sub(f.body)}}}", f.vector, f.frame, m, f"constraint force on {f.body}"
+        )
+        constraint_lines.append(line)
+        if f.support is not None:
+            tension = f.support[1]
+            constraint_lines.append(
+                Line(
+                    f"tension {f.body}",
+                    rf"T_{{{sub(f.body)}}} = {to_latex(tension)}",
+                    f"T_{f.body} = {to_plain(tension)}",
+                )
+            )
+    solved_text = (
+        "Projected on the directions the particle may move (∂r/∂q_j) the balances are "
+        "the equations of motion — the same as Lagrange's (D'Alembert, eq. 20). "
+        "Projected on the others they give R, here with q̈ from the equations of "
+        "motion: the force the constraint must supply."
+    )
+    return [
+        Step("newton", "Newton's method: Σ F = m a", text, balances),
+        Step("constraint_forces", "Constraint forces", solved_text, constraint_lines),
+    ]
+
+
+def newton_json(d: Derivation) -> dict[str, Any]:
+    """What /api/v1/newton returns: steps, constraint forces, and the agreement with Lagrange."""
+    m = d.model
+    steps, forces, residual = newton(d)
+    lagrange = [lhs - Q for lhs, Q in zip(d.work.eom_lhs, d.work.Q, strict=True)]
+    agrees = all(tidy(r - e, m) == 0 for r, e in zip(residual, lagrange, strict=True))
+    names = m.plain_vectors
+    return {
+        "steps": [s.to_json() for s in steps],
+        "constraint_forces": [
+            {
+                "body": f.body,
+                "frame": f.frame,
+                "unit_vectors": list(names(f.frame)),
+                "components": [to_plain(c) for c in f.components],
+                "latex": to_latex(f.vector),
+                "tension_toward": None if f.support is None else f.support[0],
+                "tension": None if f.support is None else to_plain(f.support[1]),
+            }
+            for f in forces
+        ],
+        "equations": {
+            name: f"{to_plain(r)} = 0" for name, r in zip(m.coordinate_names, residual, strict=True)
+        },
+        "agrees_with_lagrange": agrees,
+    }
