@@ -9,13 +9,13 @@ from __future__ import annotations
 from typing import Any
 
 from fastapi import FastAPI, Request
-from fastapi.responses import JSONResponse, RedirectResponse
+from fastapi.responses import JSONResponse
 from fastapi.staticfiles import StaticFiles
 
 from app import __version__
 from app.errors import register_error_handlers
 from app.paths import STATIC_DIR, mathjax_dir
-from app.routes import check, derive, equilibria, newton, scenes, simulate
+from app.routes import check, derive, equilibria, newton, pages, scenes, simulate
 from app.schemas import Health
 
 #: A request body past this is refused unread: no honest scene comes near it.
@@ -33,6 +33,7 @@ app.include_router(simulate.router)
 app.include_router(check.router)
 app.include_router(equilibria.router)
 app.include_router(newton.router)
+app.include_router(pages.router)
 register_error_handlers(app)
 
 _mathjax = mathjax_dir()
@@ -45,12 +46,6 @@ app.mount("/static", StaticFiles(directory=STATIC_DIR, check_dir=False), name="s
 def healthz() -> Health:
     """Liveness for load balancers and CI: answers without touching the engine."""
     return Health(version=__version__)
-
-
-@app.get("/", include_in_schema=False)
-def home() -> RedirectResponse:
-    """Until the pages land, the front door is the interactive API documentation."""
-    return RedirectResponse("/docs")
 
 
 @app.middleware("http")

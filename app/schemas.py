@@ -230,6 +230,10 @@ class SimulateResponse(BaseModel):
         description="Cumulative work since t = 0 of each conservative force (−ΔV of its part) "
         "and each non-conservative one (∫F·v dt), keyed 'kind:name'."
     )
+    forces: list[dict[str, Any]] = Field(
+        description="Every applied force on every body along the run: label (LaTeX), kind "
+        "(weight, spring, damper, force, torque), on, and x, y, z in N — the free-body diagram."
+    )
     constraint_forces: dict[str, dict[str, list[float]]] | None = Field(
         default=None, description="With constraint_forces: true — R in N (x, y, z), tension."
     )

@@ -19,6 +19,7 @@ from sympy.physics.vector import Vector
 from mechanics.derive import Derivation, derivation_of_scene, derive_model
 from mechanics.model import T as t
 from mechanics.steps.energy import potential_parts
+from mechanics.steps.fbd import body_forces
 
 
 def _sign(x: float) -> float:
@@ -45,6 +46,7 @@ class CompiledScene:
     mass_matrix: Any  # arrays or scalars: -> M flat (for the singularity check)
     powers: dict[str, Any]  # arrays: power F·v of each non-conservative force (or M·ω)
     potential_parts: dict[str, Any]  # arrays: each conservative force's share of V
+    forces: list[tuple[str, str, str, Any]]  # (label, kind, on, arrays -> x, y, z in N)
     places: dict[str, Any]  # arrays: -> (x, y, z) of each point/body
     frames: dict[str, Any]  # arrays: -> 9 components of the frame's axes in N
     solved: bool  # True: q̈ from the symbolic solution; False: M q̈ = f solved numerically
@@ -127,6 +129,12 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         powers[key] = powers.get(key, sp.S.Zero) + load.vector.dot(rate)
     powers = {k: vector([p]) for k, p in powers.items()}
     parts = {f"{kind}:{name}": vector([e]) for kind, name, e in potential_parts(m)}
+    forces = [
+        (label, kind, on, vector([vec.dot(u) for u in (m.N.x, m.N.y, m.N.z)]))
+        for on, acting in body_forces(m).items()
+        for label, kind, vec in acting
+        if on in {b.name for b in m.bodies}
+    ]
     places = {
         name: vector([r.dot(u) for u in (m.N.x, m.N.y, m.N.z)]) for name, r in m.positions.items()
     }
@@ -149,6 +157,7 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         mass_matrix=vector(list(w.mass_matrix)),
         powers=powers,
         potential_parts=parts,
+        forces=forces,
         places=places,
         frames=frames,
         solved=solved,

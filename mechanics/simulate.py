@@ -185,8 +185,18 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     extra: dict[str, Any] = {}
     if req.constraint_forces:
         extra["constraint_forces"] = _constraint_forces(c, t, q, qd, params, warnings)
+    forces = [
+        {
+            "label": label,
+            "kind": kind,
+            "on": on,
+            **dict(zip("xyz", (v.tolist() for v in evaluate(fn, t, q, qd, params)), strict=True)),
+        }
+        for label, kind, on, fn in c.forces
+    ]
     return {
         **extra,
+        "forces": forces,
         "work": work,
         "t": t.tolist(),
         "q": {name: q[i].tolist() for i, name in enumerate(c.coordinates)},
