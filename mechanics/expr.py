@@ -202,13 +202,21 @@ def parse(text: str | int | float, names: Mapping[str, sp.Expr], *, field: str =
 def _check_power(base: sp.Expr, exponent: sp.Expr, field: str, pos: int | None) -> None:
     """Refuse powers that would take sympy minutes or memory: big numeric exponents."""
     if exponent.is_number:
-        if abs(float(exponent)) > MAX_EXPONENT:
+        if _magnitude(exponent) > MAX_EXPONENT:
             raise ExprError(f"exponent larger than {MAX_EXPONENT}", field=field, position=pos)
     elif not exponent.free_symbols and exponent.atoms(sp.Function):
         raise ExprError("exponent too complex", field=field, position=pos)
     if base.is_number and exponent.is_number and base != 0:
-        if abs(float(exponent) * math.log10(abs(complex(base.evalf(5))) or 1)) > 300:
+        if abs(_magnitude(exponent) * math.log10(_magnitude(base, 5) or 1)) > 300:
             raise ExprError("number too large", field=field, position=pos)
+
+
+def _magnitude(value: sp.Expr, digits: int = 15) -> float:
+    """|value| of a number, complex ones too (sqrt(-1)); inf when it overflows a float."""
+    try:
+        return abs(complex(value.evalf(digits)))
+    except (TypeError, OverflowError):
+        return math.inf
 
 
 def free_names(text: str) -> set[str]:
