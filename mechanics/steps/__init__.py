@@ -22,6 +22,8 @@ from mechanics.expr import to_latex, to_plain
 SIMPLIFY_OPS_BUDGET = 600
 #: Up to this size sympy's full trigsimp is affordable (for tan/cot/sec/csc identities).
 SMALL_OPS = 16
+#: A sum of more terms than this is left as it is: no textbook prints one.
+MAX_TERMS = 100
 
 
 #: Pieces left unsimplified because they were over budget, per derivation (per thread/task).
@@ -96,6 +98,28 @@ def tidy(
     return _tidy_symbols(expr.xreplace(to_sym), velocities, factor_whole).xreplace(back)
 
 
+def partial(expr: sp.Expr, var: sp.Expr, model: Any) -> sp.Expr:
+    """∂expr/∂var for var one of q, q̇, q̈ (or t, explicit only), on plain symbols.
+
+    Differentiating with respect to q(t) inside sympy walks every term through the chain rule
+    for functions of t; on plain symbols it is a polynomial operation, several times faster.
+    """
+    to_sym, back = _symbols_for(model)
+    plain = expr.xreplace(to_sym)
+    return plain.diff(to_sym.get(var, var)).xreplace(back)
+
+
+def d_dt(expr: sp.Expr, model: Any) -> sp.Expr:
+    """Total time derivative: Σ ∂/∂q q̇ + ∂/∂q̇ q̈ + ∂/∂t (the notes' d/dt ∂L/∂q̇_j)."""
+    to_sym, back = _symbols_for(model)
+    plain = expr.xreplace(to_sym)
+    t = model.names["t"]
+    total = plain.diff(t)
+    for q, qd, qdd in zip(model.q, model.qd, model.qdd, strict=True):
+        total += plain.diff(to_sym[q]) * to_sym[qd] + plain.diff(to_sym[qd]) * to_sym[qdd]
+    return total.xreplace(back)
+
+
 def _symbols_for(model: Any) -> tuple[dict, dict]:
     """q(t), q̇(t), q̈(t) as plain symbols: trig passes run faster on symbols than on functions."""
     cached = getattr(model, "_tidy_symbols", None)
@@ -116,12 +140,21 @@ def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -
     e = sp.expand(expr)
     if e == 0:
         return e
+    if e.is_Add and len(e.args) > MAX_TERMS:
+        _flag(e)  # far past the budget: even grouping it costs more than it can gain
+        return e
     if velocities:
         groups = sp.collect(e, velocities, evaluate=False)
         if len(groups) > 1 or 1 not in groups:
             total = sp.Add(*(_trig_pass(c) * m for m, c in groups.items()))
             return min((total, sp.factor_terms(total)), key=_size) if factor_whole else total
     return _trig_pass(e)
+
+
+def _flag(e: sp.Expr) -> None:
+    skipped = unsimplified.get(None)
+    if skipped is not None:
+        skipped.append(e)
 
 
 def _positive_lead(e: sp.Expr) -> sp.Expr:
@@ -148,9 +181,7 @@ def _trig_pass(c: sp.Expr) -> sp.Expr:
     """sin²+cos² = 1 and products to sums of angles, keeping whichever form is smallest."""
     c = sp.expand(c)
     if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
-        skipped = unsimplified.get(None)
-        if skipped is not None:
-            skipped.append(c)
+        _flag(c)
         return c
     if c.has(sp.tan, sp.cot, sp.sec, sp.csc) and sp.count_ops(c) <= SMALL_OPS:
         c = min((c, sp.trigsimp(c)), key=_size)  # small: trigsimp is cheap here

@@ -6,8 +6,7 @@ import sympy as sp
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
-from mechanics.model import T as t
-from mechanics.steps import Line, Step, Work, eq_line, tidy
+from mechanics.steps import Line, Step, Work, d_dt, eq_line, partial, tidy
 
 
 def lagrange_equations(model: Model, work: Work) -> Step:
@@ -17,9 +16,9 @@ def lagrange_equations(model: Model, work: Work) -> Step:
     work.eom_lhs = []
     for name, qi, qdi, Qj in zip(model.coordinate_names, model.q, model.qd, work.Q, strict=True):
         ql, qdl = to_latex(qi), to_latex(qdi)
-        p = tidy(L.diff(qdi), model)
-        dp = tidy(p.diff(t), model)
-        dq = tidy(L.diff(qi), model)
+        p = tidy(partial(L, qdi, model), model)
+        dp = tidy(d_dt(p, model), model)
+        dq = tidy(partial(L, qi, model), model)
         lhs = tidy(dp - dq, model, factor_whole=False)  # an EoM reads best term by term
         work.eom_lhs.append(lhs)
         work.momenta.append(p)

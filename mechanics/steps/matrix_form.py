@@ -8,7 +8,7 @@ import sympy as sp
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
-from mechanics.steps import Line, Step, Work, eq_line, tidy
+from mechanics.steps import Line, Step, Work, eq_line, partial, tidy
 from mechanics.steps.lagrange import ratio
 
 #: Past this many seconds of derivation, q̈ is left unsolved (the simulation solves M q̈ = f).
@@ -19,7 +19,7 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
     """M is linear in q̈ by construction, so M_jk = ∂E_j/∂q̈_k and f = −E|_{q̈=0}."""
     n = len(model.q)
     residual = [lhs - Q for lhs, Q in zip(work.eom_lhs, work.Q, strict=True)]
-    M = sp.Matrix(n, n, lambda j, k: tidy(residual[j].diff(model.qdd[k]), model))
+    M = sp.Matrix(n, n, lambda j, k: tidy(partial(residual[j], model.qdd[k], model), model))
     zero = dict.fromkeys(model.qdd, 0)
     f = sp.Matrix([tidy(-r.subs(zero), model) for r in residual])
     work.mass_matrix, work.forcing = M, f
