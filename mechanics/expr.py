@@ -1,18 +1,31 @@
 """The whitelist parser (plain text -> sympy) and the printers (sympy -> plain text / LaTeX).
 
-User text reaches sympy only through `parse`: Python's own tokenizer/AST reads the text, and a walk
-over the tree admits numbers, declared names, + - * / **, and a fixed list of functions —
-nothing else is ever evaluated. Sizes, depth and exponents are capped before any algebra runs, so
-hostile input (``9**9**9**9``, 100 kB strings, deep nesting) is refused in microseconds.
+User text reaches sympy only through `parse`: Python's own parser reads the text into a syntax
+tree, and a walk over that tree admits numbers, the caller's names, + - * / **, and a fixed list of
+functions — nothing is ever executed. Length, nesting, digits and exponents are capped before any
+algebra runs, so hostile input (``9**9**9**9``, 100 kB strings, deep nesting) fails in
+microseconds instead of tying up a server worker.
+
+Decimals: a literal with an integral value below 1e15 (``2.0``, ``1e6``) becomes an Integer; one
+with at most 6 significant digits and magnitude at least 1e-6 becomes an exact Rational (``0.5`` ->
+1/2, ``9.81`` -> 981/100) so derivations print as textbooks do (``m*g*l/2``); any other decimal
+stays a 15-digit ``sympy.Float``. Python ints and floats handed to `parse` follow the same rules.
 """
 
 from __future__ import annotations
 
 import ast
+import difflib
+import keyword
 import math
+import operator
 import re
+import string
+import sys
 from collections.abc import Callable, Mapping
+from decimal import Decimal
 from fractions import Fraction
+from types import MappingProxyType
 
 import sympy as sp
 from sympy.core.function import AppliedUndef
@@ -23,218 +36,308 @@ MAX_LENGTH = 2000
 MAX_DEPTH = 32
 MAX_EXPONENT = 64
 MAX_DIGITS = 30
+# Every number must survive conversion to float64, because the simulator evaluates in floats.
+MAX_MAGNITUDE = sys.float_info.max
 
-FUNCTIONS: Mapping[str, Callable] = {
-    "sin": sp.sin,
-    "cos": sp.cos,
-    "tan": sp.tan,
-    "cot": sp.cot,
-    "sec": sp.sec,
-    "csc": sp.csc,
-    "asin": sp.asin,
-    "acos": sp.acos,
-    "atan": sp.atan,
-    "atan2": sp.atan2,
-    "sinh": sp.sinh,
-    "cosh": sp.cosh,
-    "tanh": sp.tanh,
-    "exp": sp.exp,
-    "log": sp.log,
-    "sqrt": sp.sqrt,
-    "abs": sp.Abs,
-    "sign": sp.sign,
-}
+FUNCTIONS: Mapping[str, Callable] = MappingProxyType(
+    {
+        "sin": sp.sin,
+        "cos": sp.cos,
+        "tan": sp.tan,
+        "cot": sp.cot,
+        "sec": sp.sec,
+        "csc": sp.csc,
+        "asin": sp.asin,
+        "acos": sp.acos,
+        "atan": sp.atan,
+        "atan2": sp.atan2,
+        "sinh": sp.sinh,
+        "cosh": sp.cosh,
+        "tanh": sp.tanh,
+        "exp": sp.exp,
+        "log": sp.log,
+        "sqrt": sp.sqrt,
+        "abs": sp.Abs,
+        "sign": sp.sign,
+    }
+)
 _ARITY = {"atan2": 2}
-CONSTANTS: Mapping[str, sp.Expr] = {"pi": sp.pi}
+CONSTANTS: Mapping[str, sp.Expr] = MappingProxyType({"pi": sp.pi})
 
-_ALLOWED_CHARS = re.compile(r"[A-Za-z0-9_+\-*/().,\s]")
-_BINOPS = {
-    ast.Add: lambda a, b: a + b,
-    ast.Sub: lambda a, b: a - b,
-    ast.Mult: lambda a, b: a * b,
-    ast.Div: lambda a, b: a / b,
-    ast.Pow: lambda a, b: a**b,
+_ALLOWED_CHARS = frozenset(string.ascii_letters + string.digits + "_+-*/()., \t\r\n")
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_TO_SPACE = str.maketrans("\t\r\n", "   ")
+_ARITHMETIC = {
+    ast.Add: operator.add,
+    ast.Sub: operator.sub,
+    ast.Mult: operator.mul,
+    ast.Div: operator.truediv,
+    ast.Pow: operator.pow,
 }
-_NOT_ALLOWED = {
+# Friendly words for the syntax the character filter still lets through (and, defensively, some
+# it does not), so an error says what the user wrote rather than an AST class name.
+_REFUSALS: dict[type, str] = {
+    ast.FloorDiv: "'//' is not allowed; write /",
+    ast.BitXor: "'^' is not allowed; write powers as **",
     ast.Attribute: "attribute access is not allowed",
+    ast.Tuple: "a comma may only separate a function's arguments",
+    ast.Starred: "'*' before an argument is not allowed",
     ast.Lambda: "lambda is not allowed",
     ast.Subscript: "subscripts are not allowed",
     ast.Compare: "comparisons are not allowed",
     ast.BoolOp: "'and'/'or' are not allowed",
-    ast.BitXor: "'^' is not allowed; write powers as **",
+    ast.IfExp: "'if'/'else' are not allowed",
+    ast.GeneratorExp: "generator expressions are not allowed",
 }
 
 
 class ExprError(ValueError):
-    """An expression that is not in the plain-text convention; names the field it came from."""
+    """An expression outside the plain-text convention; the field and offset let the UI point."""
 
     def __init__(self, message: str, *, field: str = "", position: int | None = None) -> None:
         self.field, self.message, self.position = field, message, position
         super().__init__(f"{field}: {message}" if field else message)
 
 
-def _number(value: int | float | Fraction, field: str) -> sp.Expr:
-    if isinstance(value, bool):
-        raise ExprError("true/false is not a number", field=field)
+def _number(value: object, field: str, position: int | None = None) -> sp.Expr:
+    """Exact where a person would mean exact (see the module docstring), capped in size."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        kind = "true/false" if isinstance(value, bool) else f"{type(value).__name__} literals"
+        raise ExprError(f"{kind} are not allowed", field=field, position=position)
     if isinstance(value, int):
-        if len(str(abs(value))) > MAX_DIGITS:
-            raise ExprError("number too large", field=field)
+        if abs(value) >= 10**MAX_DIGITS:
+            raise ExprError(
+                f"integer longer than {MAX_DIGITS} digits", field=field, position=position
+            )
         return sp.Integer(value)
     if not math.isfinite(value):
-        raise ExprError("not a finite number", field=field)
-    # Short decimals become exact rationals, so 0.5*m*v**2 prints as m*v**2/2.
-    text = repr(value)
-    if len(text.replace("-", "").replace(".", "").lstrip("0")) <= 6 and "e" not in text:
-        return sp.Rational(text)
-    return sp.Float(value, 15)
+        raise ExprError("not a finite number", field=field, position=position)
+    if value.is_integer() and abs(value) < 1e15:
+        return sp.Integer(int(value))
+    decimal = Decimal(repr(value))
+    if len(decimal.normalize().as_tuple().digits) <= 6 and abs(value) >= 1e-6:
+        exact = Fraction(decimal)
+        return sp.Rational(exact.numerator, exact.denominator)
+    return sp.Float(repr(value), 15)
 
 
-def _precheck(text: str, field: str) -> str:
+def _magnitude(value: sp.Expr) -> float:
+    """|value| of a closed-form number (complex ones too); inf when it is not a finite float."""
+    try:
+        size = abs(complex(value.evalf(15)))
+    except (TypeError, ValueError, OverflowError, ArithmeticError):
+        return math.inf
+    return size if math.isfinite(size) else math.inf
+
+
+def _precheck(text: object, field: str) -> tuple[str, int]:
+    """Cheap linear scans that refuse hostile text before Python's parser or sympy see it.
+
+    Returns the stripped text (tabs/newlines as spaces, so AST columns are character offsets)
+    and how far it starts into the original, so positions always index what the user typed.
+    """
     if not isinstance(text, str):
-        raise ExprError("expected text or a number", field=field)
+        raise ExprError(f"expected text or a number, not {type(text).__name__}", field=field)
     if len(text) > MAX_LENGTH:
-        raise ExprError(f"expression longer than {MAX_LENGTH} characters", field=field)
-    depth = 0
+        raise ExprError(f"longer than {MAX_LENGTH} characters ({len(text)})", field=field)
+    for word in _WORD.finditer(text):
+        if keyword.iskeyword(word.group()):
+            raise ExprError(f"'{word.group()}' is not allowed", field=field, position=word.start())
+        if "__" in word.group():
+            raise ExprError("names with '__' are not allowed", field=field, position=word.start())
+    opened: list[int] = []
     for i, ch in enumerate(text):
-        if not _ALLOWED_CHARS.match(ch):
+        if ch not in _ALLOWED_CHARS:
             if ch == "^":
                 raise ExprError("'^' is not allowed; write powers as **", field=field, position=i)
             raise ExprError(f"character {ch!r} is not allowed", field=field, position=i)
         if ch == "(":
-            depth += 1
-            if depth > MAX_DEPTH:
-                raise ExprError(f"nested deeper than {MAX_DEPTH}", field=field, position=i)
+            opened.append(i)
+            if len(opened) > MAX_DEPTH:
+                raise ExprError(
+                    f"parentheses nested deeper than {MAX_DEPTH}", field=field, position=i
+                )
         elif ch == ")":
-            depth -= 1
-    if "__" in text:
-        raise ExprError("names with '__' are not allowed", field=field, position=text.index("__"))
-    text = text.strip()
-    if not text:
+            if not opened:
+                raise ExprError("')' without a matching '('", field=field, position=i)
+            opened.pop()
+    if opened:
+        raise ExprError("'(' is never closed", field=field, position=opened[-1])
+    stripped = text.strip()
+    if not stripped:
         raise ExprError("empty expression", field=field)
-    return text
+    return stripped.translate(_TO_SPACE), len(text) - len(text.lstrip())
 
 
-def _tree(text: str, field: str) -> ast.expr:
+def _tree(text: object, field: str) -> tuple[ast.expr, int]:
+    clean, offset = _precheck(text, field)
     try:
-        return ast.parse(text, mode="eval").body
+        return ast.parse(clean, mode="eval").body, offset
     except SyntaxError as exc:
-        col = (exc.offset or 1) - 1
+        col = offset + max((exc.offset or 1) - 1, 0)
         raise ExprError(f"syntax error at character {col}", field=field, position=col) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExprError("expression too complex", field=field) from None
 
 
-def parse(text: str | int | float, names: Mapping[str, sp.Expr], *, field: str = "") -> sp.Expr:
-    """Plain text (or a number) -> sympy, admitting only the whitelist and the given names."""
-    if isinstance(text, int | float):
-        return _number(text, field)
-    tree = _tree(_precheck(text, field), field)
+class _Builder:
+    """Turns a checked syntax tree into sympy, bottom-up, refusing anything off the whitelist."""
 
-    def walk(node: ast.AST, depth: int) -> sp.Expr:
+    def __init__(self, names: Mapping[str, sp.Expr], field: str, offset: int) -> None:
+        self.names, self.field, self.offset = names, field, offset
+
+    def error(self, message: str, node: ast.AST | None = None) -> ExprError:
+        col = getattr(node, "col_offset", None)
+        return ExprError(
+            message, field=self.field, position=None if col is None else col + self.offset
+        )
+
+    def build(self, node: ast.AST, depth: int = 0) -> sp.Expr:
         if depth > MAX_DEPTH:
-            raise ExprError(f"nested deeper than {MAX_DEPTH}", field=field)
-        pos = getattr(node, "col_offset", None)
-        if isinstance(node, ast.Constant):
-            if isinstance(node.value, int | float) and not isinstance(node.value, bool):
-                return _number(node.value, field)
-            raise ExprError(
-                f"{type(node.value).__name__} literals are not allowed", field=field, position=pos
-            )
-        if isinstance(node, ast.Name):
-            if node.id in names:
-                return names[node.id]
-            if node.id in CONSTANTS:
-                return CONSTANTS[node.id]
-            if node.id in FUNCTIONS:
-                raise ExprError(f"function '{node.id}' needs arguments", field=field, position=pos)
-            known = sorted(names)
-            hint = f" (known: {', '.join(known[:12])}{', ...' if len(known) > 12 else ''})"
-            raise ExprError(f"unknown name '{node.id}'{hint}", field=field, position=pos)
+            raise self.error(f"nested deeper than {MAX_DEPTH} levels", node)
+        if isinstance(node, ast.BinOp) and type(node.op) in _ARITHMETIC:
+            return self.chain(node, depth)
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-            value = walk(node.operand, depth + 1)
+            value = self.build(node.operand, depth + 1)
             return -value if isinstance(node.op, ast.USub) else value
-        if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
-            left = walk(node.left, depth + 1)
-            right = walk(node.right, depth + 1)
-            if isinstance(node.op, ast.Pow):
-                _check_power(left, right, field, pos)
-            if isinstance(node.op, ast.Div) and right == 0:
-                raise ExprError("division by zero", field=field, position=pos)
-            result = _BINOPS[type(node.op)](left, right)
-            if result.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
-                raise ExprError("not a finite number", field=field, position=pos)
-            return result
+        if isinstance(node, ast.Constant):
+            if isinstance(node.value, complex):
+                raise self.error("complex numbers are not allowed", node)
+            if node.value is Ellipsis:
+                raise self.error("'...' is not allowed", node)
+            return _number(node.value, self.field, self.at(node))
+        if isinstance(node, ast.Name):
+            return self.name(node)
         if isinstance(node, ast.Call):
-            return call(node, depth)
-        for kind, message in _NOT_ALLOWED.items():
-            if isinstance(node, kind) or isinstance(getattr(node, "op", None), kind):
-                raise ExprError(message, field=field, position=pos)
-        raise ExprError(f"{type(node).__name__} is not allowed", field=field, position=pos)
+            return self.call(node, depth)
+        refusal = _REFUSALS.get(type(getattr(node, "op", None))) or _REFUSALS.get(type(node))
+        raise self.error(refusal or f"{type(node).__name__} is not allowed", node)
 
-    def call(node: ast.Call, depth: int) -> sp.Expr:
-        pos = node.col_offset
+    def at(self, node: ast.AST) -> int:
+        return node.col_offset + self.offset
+
+    def chain(self, node: ast.BinOp, depth: int) -> sp.Expr:
+        # a+b+c+... leans left in the AST; walking that spine in a loop keeps a long sum of terms
+        # (an equation of motion) from counting as deep nesting or exhausting Python's stack, and
+        # handing each run of + - (or * /) to one Add (Mul) keeps it linear rather than quadratic.
+        spine = []
+        while isinstance(node, ast.BinOp) and type(node.op) in _ARITHMETIC:
+            spine.append(node)
+            node = node.left
+        value = self.build(node, depth + 1)
+        run: list[sp.Expr] = []
+        combine: Callable = sp.Add
+        last: ast.AST = node
+        for op_node in reversed(spine):
+            op = type(op_node.op)
+            right = self.build(op_node.right, depth + 1)
+            if op is ast.Pow:
+                value = self.finite(combine(value, *run), last) if run else value
+                run = []
+                self.check_power(value, right, op_node)
+                value = self.finite(value**right, op_node)
+                continue
+            kind = sp.Add if op in (ast.Add, ast.Sub) else sp.Mul
+            if run and kind is not combine:
+                value, run = self.finite(combine(value, *run), last), []
+            if op is ast.Div and right == 0:
+                raise self.error("division by zero", op_node)
+            combine, last = kind, op_node
+            run.append(-right if op is ast.Sub else 1 / right if op is ast.Div else right)
+        return self.finite(combine(value, *run), last) if run else value
+
+    def check_power(self, base: sp.Expr, exponent: sp.Expr, node: ast.AST) -> None:
+        """Refuse powers before sympy computes them: 9**387420489 would take minutes and memory."""
+        if not exponent.is_number:
+            return
+        size = _magnitude(exponent)
+        if size > MAX_EXPONENT:
+            raise self.error(f"exponent too large (the limit is {MAX_EXPONENT})", node)
+        if base.is_number and base != 0:
+            if size * abs(math.log10(_magnitude(base) or 1.0)) > 300:
+                raise self.error("number too large or too small", node)
+
+    def finite(self, value: sp.Expr, node: ast.AST) -> sp.Expr:
+        # Only numbers can overflow or become zoo/nan (x/0 is refused separately), and a run's
+        # numbers collect in the top Add/Mul's arguments (the 10**600 of 1e300*1e300*x).
+        # `is_number` stops at a term's first symbol, so this stays cheap on long sums.
+        if value.is_number:
+            parts: tuple = (value,)
+        else:
+            parts = value.args if isinstance(value, sp.Add | sp.Mul) else ()
+        for part in parts:
+            if part.is_number and _magnitude(part) > MAX_MAGNITUDE:
+                raise self.error("not a finite number", node)
+        return value
+
+    def name(self, node: ast.Name) -> sp.Expr:
+        if node.id in self.names:
+            return self.names[node.id]
+        if node.id in CONSTANTS:
+            return CONSTANTS[node.id]
+        if node.id in FUNCTIONS:
+            raise self.error(f"function '{node.id}' needs arguments in parentheses", node)
+        message = f"unknown name '{node.id}'"
+        close = difflib.get_close_matches(node.id, list(self.names), n=1)
+        if close:
+            message += f"; did you mean '{close[0]}'?"
+        known = sorted(self.names)
+        if known:
+            more = ", ..." if len(known) > 12 else ""
+            message += f" (known: {', '.join(known[:12])}{more})"
+        raise self.error(message, node)
+
+    def call(self, node: ast.Call, depth: int) -> sp.Expr:
         if not isinstance(node.func, ast.Name):
-            raise ExprError("only the listed functions may be called", field=field, position=pos)
+            raise self.error("only the listed functions may be called, by name", node)
         name = node.func.id
         if name not in FUNCTIONS:
-            raise ExprError(
-                f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})",
-                field=field,
-                position=pos,
+            if name in self.names or name in CONSTANTS:
+                raise self.error(
+                    f"function '{name}' is not allowed: '{name}' is a name; write '*' to multiply",
+                    node,
+                )
+            raise self.error(
+                f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})", node
             )
         if node.keywords:
-            raise ExprError(f"{name}() takes no keyword arguments", field=field, position=pos)
+            raise self.error(f"{name}() takes no keyword arguments", node)
+        for arg in node.args:
+            if isinstance(arg, ast.Starred):
+                raise self.error(_REFUSALS[ast.Starred], arg)
         arity = _ARITY.get(name, 1)
-        if len(node.args) != arity or any(isinstance(a, ast.Starred) for a in node.args):
-            raise ExprError(
-                f"{name}() takes {arity} argument{'s' if arity > 1 else ''}",
-                field=field,
-                position=pos,
-            )
-        result = FUNCTIONS[name](*(walk(a, depth + 1) for a in node.args))
-        if result.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
-            raise ExprError("not a finite number", field=field, position=pos)
-        return result
-
-    return walk(tree, 0)
+        if len(node.args) != arity:
+            plural = "s" if arity > 1 else ""
+            raise self.error(f"{name}() takes {arity} argument{plural}, not {len(node.args)}", node)
+        args = [self.build(arg, depth + 1) for arg in node.args]
+        return self.finite(FUNCTIONS[name](*args), node)
 
 
-def _check_power(base: sp.Expr, exponent: sp.Expr, field: str, pos: int | None) -> None:
-    """Refuse powers that would take sympy minutes or memory: big numeric exponents."""
-    if exponent.is_number:
-        if _magnitude(exponent) > MAX_EXPONENT:
-            raise ExprError(f"exponent larger than {MAX_EXPONENT}", field=field, position=pos)
-    elif not exponent.free_symbols and exponent.atoms(sp.Function):
-        raise ExprError("exponent too complex", field=field, position=pos)
-    if base.is_number and exponent.is_number and base != 0:
-        if abs(_magnitude(exponent) * math.log10(_magnitude(base, 5) or 1)) > 300:
-            raise ExprError("number too large", field=field, position=pos)
+def parse(text: str | int | float, names: Mapping[str, sp.Expr], *, field: str = "") -> sp.Expr:
+    """The only way user text becomes sympy: every node is checked against the whitelist."""
+    if isinstance(text, int | float) and not isinstance(text, bool):
+        return _number(text, field)
+    tree, offset = _tree(text, field)
+    result = _Builder(names, field, offset).build(tree)
+    if result.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
+        raise ExprError("not a finite number", field=field)
+    return result
 
 
-def _magnitude(value: sp.Expr, digits: int = 15) -> float:
-    """|value| of a number, complex ones too (sqrt(-1)); inf when it overflows a float."""
-    try:
-        return abs(complex(value.evalf(digits)))
-    except (TypeError, OverflowError):
-        return math.inf
-
-
-def free_names(text: str) -> set[str]:
-    """Identifiers the text uses (not function names or pi), after the same safety checks."""
-    tree = _tree(_precheck(text, ""), "")
-    return (
-        {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} - set(FUNCTIONS) - set(CONSTANTS)
-    )
+def free_names(text: str, *, field: str = "") -> set[str]:
+    """The identifiers a text uses, so callers can report every unknown name at once."""
+    tree, _ = _tree(text, field)
+    used = {node.id for node in ast.walk(tree) if isinstance(node, ast.Name)}
+    return used - set(FUNCTIONS) - set(CONSTANTS)
 
 
 class _PlainPrinter(StrPrinter):
-    """sympy's str printer, with q(t) -> q, q̇ -> q_dot, Abs -> abs: parseable by `parse`."""
+    """sympy's str printer, made to speak the input convention so its output parses back."""
 
     def _print_Function(self, expr: sp.Expr) -> str:
-        if isinstance(expr, AppliedUndef):
+        # theta(t) is what the user calls theta.
+        if isinstance(expr, AppliedUndef) and len(expr.args) == 1 and expr.args[0].is_Symbol:
             return expr.func.__name__
-        if isinstance(expr, sp.Abs):
-            return f"abs({self._print(expr.args[0])})"
         return super()._print_Function(expr)
 
     def _print_Abs(self, expr: sp.Expr) -> str:
@@ -243,28 +346,40 @@ class _PlainPrinter(StrPrinter):
     def _print_Derivative(self, expr: sp.Derivative) -> str:
         base = expr.expr
         order = sum(count for _, count in expr.variable_count)
-        if isinstance(base, AppliedUndef) and order in (1, 2):
+        if (
+            isinstance(base, AppliedUndef)
+            and len(base.args) == 1
+            and all(var == base.args[0] for var, _ in expr.variable_count)
+            and order in (1, 2)
+        ):
             return f"{base.func.__name__}_{'d' * (order - 1)}dot"
         return super()._print_Derivative(expr)
 
     def _print_Float(self, expr: sp.Float) -> str:
-        value = float(expr)
-        return repr(int(value)) + ".0" if value.is_integer() and abs(value) < 1e15 else repr(value)
+        text = format(float(expr), ".15g")
+        return text if any(c in text for c in ".ein") else text + ".0"
 
     def _print_Exp1(self, expr: sp.Expr) -> str:
         return "exp(1)"
+
+    def _print_ImaginaryUnit(self, expr: sp.Expr) -> str:
+        return "sqrt(-1)"
 
 
 _PLAIN = _PlainPrinter({"order": None})
 
 
 def to_plain(expr: sp.Expr | list) -> str:
-    """sympy -> plain text in the project's convention (round-trips through `parse`)."""
+    """Plain text in the input convention, so a result can be pasted back into an input field."""
     if isinstance(expr, list):
         return "[" + ", ".join(to_plain(e) for e in expr) + "]"
     return _PLAIN.doprint(expr)
 
 
 def to_latex(expr: sp.Expr) -> str:
-    """Textbook LaTeX: dot notation for time derivatives, Greek names as letters."""
+    """Textbook LaTeX: dots for time derivatives, Greek names as letters, digits as subscripts.
+
+    vlatex (not sympy.latex) because it drops the (t) of coordinates and draws q' as a dot;
+    it accepts physics.vector Vectors and matrices too.
+    """
     return vlatex(expr)
