@@ -1,25 +1,31 @@
 """A registry of ODE integrators behind one interface, like scipy's ``solve_ivp(method=...)``.
 
-The fixed-step methods are there to teach the trade (order, symplecticity, cost per step); the
-adaptive ones are scipy's. Every run samples the solution at the requested times (dense output,
-not the raw steps), counts what it cost, and stops — returning what it has, with the reason —
-when the state stops being finite or a budget runs out. It never hangs.
+Students trade speed for accuracy: the fixed-step methods are here to teach that trade (order,
+symplecticity, cost per step), the adaptive ones are scipy's steppers. Every run samples the
+solution only at the requested output times (dense output, not the raw steps), counts what it
+cost, and never hangs: when the state stops being finite, the solver gives up, or a budget (wall
+time, steps) runs out, it stops and returns the partial trajectory with the reason.
 """
 
 from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate as si
 
+Rhs = Callable[[float, np.ndarray], np.ndarray]
+
 
 @dataclass(frozen=True)
 class MethodInfo:
-    name: str
+    """What the app shows about a method, so students can pick one knowingly."""
+
+    name: str  # registry key, e.g. "rk4"
     label: str
     kind: str  # "fixed" | "adaptive"
     order: int
@@ -28,142 +34,114 @@ class MethodInfo:
     description: str
 
 
+# fmt: off
 METHODS: dict[str, MethodInfo] = {
     m.name: m
     for m in (
-        MethodInfo(
-            "euler",
-            "Explicit Euler",
-            "fixed",
-            1,
-            False,
-            False,
-            "One slope per step. Cheap and simple; energy grows steadily — shows why "
-            "nobody integrates orbits with it.",
-        ),
-        MethodInfo(
-            "symplectic_euler",
-            "Semi-implicit (symplectic) Euler",
-            "fixed",
-            1,
-            True,
-            False,
-            "Update the velocity first, then the position with the new velocity. "
-            "First order, but the energy error stays bounded over long runs.",
-        ),
-        MethodInfo(
-            "rk4",
-            "Classical Runge–Kutta (RK4)",
-            "fixed",
-            4,
-            False,
-            False,
-            "Four slopes per step; very accurate per step, but the energy drifts slowly "
-            "in long conservative runs.",
-        ),
-        MethodInfo(
-            "implicit_midpoint",
-            "Implicit midpoint",
-            "fixed",
-            2,
-            True,
-            True,
-            "Symplectic and time-reversible: conserves quadratic invariants exactly and "
-            "keeps the energy error bounded; each step solves a small nonlinear system.",
-        ),
-        MethodInfo(
-            "RK45",
-            "Dormand–Prince 5(4) (scipy RK45)",
-            "adaptive",
-            5,
-            False,
-            False,
-            "The general-purpose default of scipy: adapts the step to rtol/atol.",
-        ),
-        MethodInfo(
-            "DOP853",
-            "Dormand–Prince 8(5,3) (scipy DOP853)",
-            "adaptive",
-            8,
-            False,
-            False,
-            "High order: the cheapest way to very tight tolerances on smooth problems.",
-        ),
-        MethodInfo(
-            "dop853_fortran",
-            "DOP853, Hairer's Fortran code (scipy ode)",
-            "adaptive",
-            8,
-            False,
-            False,
-            "The same method as DOP853, stepped in compiled Fortran: several times less "
-            "overhead per step, for fast tight-tolerance runs.",
-        ),
-        MethodInfo(
-            "Radau",
-            "Radau IIA (scipy Radau)",
-            "adaptive",
-            5,
-            False,
-            True,
-            "Implicit, L-stable: for stiff systems (very stiff springs) where explicit "
-            "methods need absurdly small steps.",
-        ),
-        MethodInfo(
-            "BDF",
-            "Backward differentiation (scipy BDF)",
-            "adaptive",
-            5,
-            False,
-            True,
-            "Implicit multistep of variable order 1–5: for stiff systems.",
-        ),
-        MethodInfo(
-            "LSODA",
-            "LSODA (scipy)",
-            "adaptive",
-            12,
-            False,
-            True,
-            "Switches between Adams (non-stiff) and BDF (stiff) automatically.",
-        ),
+        MethodInfo("euler", "Explicit Euler", "fixed", 1, False, False,
+            "One slope per step. Cheap and simple, but the energy of an oscillator grows "
+            "every step: the textbook example of what not to integrate orbits with."),
+        MethodInfo("symplectic_euler", "Semi-implicit (symplectic) Euler", "fixed", 1, True, False,
+            "Update the velocity first, then the position with the new velocity. Still first "
+            "order, yet the energy error stays bounded over very long runs."),
+        MethodInfo("rk4", "Classical Runge–Kutta (RK4)", "fixed", 4, False, False,
+            "Four slopes per step: very accurate per step, but in long conservative runs the "
+            "energy drifts slowly one way."),
+        MethodInfo("implicit_midpoint", "Implicit midpoint", "fixed", 2, True, True,
+            "Symplectic and time-reversible: conserves quadratic invariants exactly and keeps "
+            "the energy error bounded; each step solves a small nonlinear system."),
+        MethodInfo("RK45", "Dormand–Prince 5(4) (scipy RK45)", "adaptive", 5, False, False,
+            "scipy's general-purpose default: adapts the step to meet rtol/atol."),
+        MethodInfo("DOP853", "Dormand–Prince 8(5,3) (scipy DOP853)", "adaptive", 8, False, False,
+            "High order: the cheapest way to very tight tolerances on smooth problems."),
+        MethodInfo("dop853_fortran", "DOP853, Hairer's Fortran code (scipy ode)", "adaptive", 8,
+            False, False,
+            "The same method as DOP853 stepped in compiled Fortran: less overhead per step, "
+            "for fast tight-tolerance runs."),
+        MethodInfo("Radau", "Radau IIA (scipy Radau)", "adaptive", 5, False, True,
+            "Implicit and L-stable: for stiff systems (very stiff springs) where explicit "
+            "methods need absurdly small steps."),
+        MethodInfo("BDF", "Backward differentiation (scipy BDF)", "adaptive", 5, False, True,
+            "Implicit multistep of variable order 1–5 (5 is the maximum): for stiff systems."),
+        MethodInfo("LSODA", "LSODA (scipy)", "adaptive", 12, False, True,
+            "Switches automatically between Adams (non-stiff, order up to 12) and BDF "
+            "(stiff, order up to 5)."),
     )
 }
+# fmt: on
 
 _SCIPY = {"RK45": si.RK45, "DOP853": si.DOP853, "Radau": si.Radau, "BDF": si.BDF, "LSODA": si.LSODA}
 
 
 @dataclass
 class Trajectory:
-    t: np.ndarray
+    """The samples reached (a prefix of t_eval) and what they cost."""
+
+    t: np.ndarray  # the requested output times actually reached
     y: np.ndarray  # (len(t), n_state)
     status: str  # "ok" | "stopped"
-    message: str
-    nfev: int
-    nsteps: int
-    njev: int
-    wall_time: float
+    message: str  # why it stopped ("" when ok)
+    nfev: int  # right-hand-side evaluations, Jacobian differences and implicit solves included
+    nsteps: int  # accepted steps
+    njev: int  # Jacobian evaluations (0 when the method has none)
+    wall_time: float  # seconds
+
+
+class _Stop(Exception):
+    """Ends a run early; the message says why and when."""
+
+
+def _finite(v: np.ndarray) -> bool:
+    """All entries finite? A sum of Python floats is ten times cheaper than np.isfinite on the
+    few numbers of a state, and it runs on every RHS call (NaN and ±inf propagate into it)."""
+    return math.isfinite(sum(v.tolist()))
 
 
 class _Counted:
-    """Wraps the RHS to count calls and enforce the wall-time budget from inside the solver."""
+    """Wraps the RHS: counts calls, enforces the wall-time deadline from inside the solver, and
+    remembers where the RHS first returned a non-finite value (so a solver failure can be
+    blamed on it). With ``fortran`` set it never raises — an exception through scipy's Fortran
+    callback kills the process — but stores the failure and returns zeros until the step ends.
+    """
 
-    def __init__(self, rhs: Callable, deadline: float) -> None:
-        self.rhs, self.deadline, self.calls = rhs, deadline, 0
+    def __init__(self, rhs: Rhs, budget: float, start: float) -> None:
+        self.rhs, self.budget, self.deadline = rhs, budget, start + budget
+        self.calls, self.t = 0, math.nan
+        self.watch = self.fortran = False
+        self.bad_t: float | None = None
+        self.failure: BaseException | None = None
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         self.calls += 1
-        if self.calls % 256 == 0 and time.perf_counter() > self.deadline:
-            raise _OutOfTime
-        return self.rhs(t, y)
+        self.t = t
+        if self.failure is not None:
+            return np.zeros_like(y)
+        try:
+            if time.perf_counter() > self.deadline:
+                raise _Stop(f"wall-time budget of {self.budget:g} s exhausted at t = {t:.6g} s")
+            d = self.rhs(t, y)
+        except Exception as exc:
+            if not self.fortran:
+                raise
+            self.failure = exc
+            return np.zeros_like(y)
+        if self.watch and not _finite(d):
+            self.bad_t = t if self.bad_t is None else self.bad_t
+            if self.fortran:
+                self.failure = _Stop(f"the right-hand side became non-finite at t = {t:.6g} s")
+                return np.zeros_like(y)
+        return d
 
 
-class _OutOfTime(Exception):
-    pass
+class _Run:
+    """The samples and counters so far: they survive a `_Stop` raised anywhere in a run."""
+
+    def __init__(self, y0: np.ndarray) -> None:
+        self.out, self.nsteps, self.njev = [y0.copy()], 0, 0
 
 
 def integrate(
-    rhs: Callable[[float, np.ndarray], np.ndarray],
+    rhs: Rhs,
     y0: np.ndarray,
     t_eval: np.ndarray,
     *,
@@ -175,152 +153,172 @@ def integrate(
     max_steps: int = 5_000_000,
     second_order: int | None = None,
 ) -> Trajectory:
-    """Integrate dy/dt = rhs(t, y) and sample at t_eval (increasing, starting at t0).
+    """Integrate dy/dt = rhs(t, y) from y0 and sample it at t_eval (increasing, from t0).
 
-    `second_order` = n says y = [q (n), v (n), extra...] with dq/dt = v: the symplectic methods
-    need that split. Extra states (e.g. the work of non-conservative forces) follow along.
+    Fixed-step methods need ``dt``; they land exactly on every output time (each interval gets
+    ⌈Δt/dt⌉ equal steps of size ≤ dt), so every sample is a genuine step of the method, never
+    an interpolation. Adaptive methods use ``rtol``/``atol`` and sample by the solver's own
+    dense output. ``second_order`` = n says y = [q (n), v (n), extra...] with dq/dt = v;
+    symplectic Euler needs that split (None means y = [q, v] in halves). Extra states (e.g.
+    the work of non-conservative forces) ride along with the method's update.
     """
     if method not in METHODS:
-        raise ValueError(f"unknown method '{method}'; one of {', '.join(METHODS)}")
-    start = time.perf_counter()
-    f = _Counted(rhs, start + max_wall_time)
+        raise ValueError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
     t_eval = np.asarray(t_eval, dtype=float)
     y0 = np.asarray(y0, dtype=float)
+    if t_eval.ndim != 1 or len(t_eval) == 0 or not np.all(np.isfinite(t_eval)):
+        raise ValueError("t_eval must be a non-empty 1-D array of finite times")
+    if np.any(np.diff(t_eval) <= 0):
+        raise ValueError("t_eval must be strictly increasing")
+    if y0.ndim != 1 or not np.all(np.isfinite(y0)):
+        raise ValueError("y0 must be a 1-D array of finite numbers")
+    n = len(y0) // 2 if second_order is None else second_order
+    if not 0 <= 2 * n <= len(y0) or (method == "symplectic_euler" and n == 0):
+        raise ValueError(f"second_order={second_order} does not split a state of {len(y0)}")
+    if method == "symplectic_euler" and second_order is None and len(y0) % 2:
+        raise ValueError("symplectic_euler needs y = [q, v]: give second_order=n for this state")
+    if METHODS[method].kind == "fixed" and (dt is None or not (math.isfinite(dt) and dt > 0)):
+        raise ValueError(f"{method} is a fixed-step method: give a finite step dt > 0")
+    start = time.perf_counter()
     if len(t_eval) == 1:
-        return Trajectory(t_eval, y0[None, :].copy(), "ok", "", 0, 0, 0, 0.0)
-    if METHODS[method].kind == "fixed":
-        if dt is None or not dt > 0 or not math.isfinite(dt):
-            raise ValueError(f"{method} is a fixed-step method: give a step dt > 0")
-        out, status, message, nsteps = _fixed(method, f, y0, t_eval, dt, max_steps, second_order)
-        njev = 0
-    elif method == "dop853_fortran":
-        out, status, message, nsteps = _fortran(f, y0, t_eval, rtol, atol, max_steps)
-        njev = 0
-    else:
-        out, status, message, nsteps, njev = _adaptive(method, f, y0, t_eval, rtol, atol, max_steps)
-    ys = np.array(out) if out else np.empty((0, len(y0)))
+        return Trajectory(t_eval.copy(), y0[None, :].copy(), "ok", "", 0, 0, 0, 0.0)
+
+    f, run = _Counted(rhs, max_wall_time, start), _Run(y0)
+    status, message = "ok", ""
+    try:
+        with np.errstate(all="ignore"):  # non-finite values are detected and reported, not warned
+            if METHODS[method].kind == "fixed":
+                _fixed(run, _STEPPERS[method], f, t_eval, dt, max_steps, n)
+            elif method == "dop853_fortran":
+                _fortran(run, f, y0, t_eval, rtol, atol, max_steps)
+            else:
+                _adaptive(run, _SCIPY[method], f, y0, t_eval, rtol, atol, max_steps)
+    except _Stop as stop:
+        status, message = "stopped", str(stop)
+    except (ArithmeticError, np.linalg.LinAlgError) as exc:  # e.g. math.exp overflow in the rhs
+        status, message = "stopped", f"{type(exc).__name__} near t = {f.t:.6g} s: {exc}"
     return Trajectory(
-        t_eval[: len(out)], ys, status, message, f.calls, nsteps, njev, time.perf_counter() - start
+        t_eval[: len(run.out)].copy(),
+        np.array(run.out),
+        status,
+        message,
+        f.calls,
+        run.nsteps,
+        run.njev,
+        time.perf_counter() - start,
     )
 
 
-def _adaptive(method, f, y0, t_eval, rtol, atol, max_steps):
-    """Step scipy's solver by hand so a run can stop with what it has, and sample densely."""
-    out = [y0.copy()]
+def _fixed(run: _Run, step, f: _Counted, t_eval, dt, max_steps, n) -> None:
+    """Exact landing: each output interval gets ⌈Δt/dt⌉ equal steps of size ≤ dt."""
+    y = run.out[0]
+    for k in range(1, len(t_eval)):
+        t0, t1 = t_eval[k - 1], t_eval[k]
+        m = max(1, math.ceil((t1 - t0) / dt - 1e-9))  # tolerate Δt/dt = 10.000000000002
+        h = (t1 - t0) / m
+        for i in range(m):
+            if run.nsteps >= max_steps:
+                raise _Stop(f"step budget ({max_steps}) exhausted at t = {t0 + i * h:.6g} s")
+            y = step(f, t0 + i * h, y, h, n)
+            run.nsteps += 1
+            if not _finite(y):
+                raise _Stop(f"state became non-finite at t = {t0 + (i + 1) * h:.6g} s")
+        run.out.append(y)
+
+
+def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) -> None:
+    """Step scipy's solver class by hand: partial results, exact stats, budgets per step.
+
+    (solve_ivp would only report at the end.) After each accepted step, the output times inside
+    it are sampled from the step's dense-output interpolant.
+    """
+    f.watch = True
+    solver = cls(f, t_eval[0], y0, t_eval[-1], rtol=rtol, atol=atol)
     k = 1
-    try:
-        solver = _SCIPY[method](f, t_eval[0], y0, t_eval[-1], rtol=rtol, atol=atol)
-        nsteps = 0
-        while k < len(t_eval):
+    while k < len(t_eval):
+        if run.nsteps >= max_steps:
+            raise _Stop(f"step budget ({max_steps}) exhausted at t = {solver.t:.6g} s")
+        f.bad_t = None
+        try:
             message = solver.step()
-            if solver.status == "failed":
-                return out, "stopped", f"{message} at t = {solver.t:.6g} s", nsteps, solver.njev
-            nsteps += 1
-            if nsteps > max_steps:
-                return (
-                    out,
-                    "stopped",
-                    f"step budget ({max_steps}) exhausted at t = {solver.t:.6g} s",
-                    nsteps,
-                    solver.njev,
-                )
-            if not np.all(np.isfinite(solver.y)):
-                return (
-                    out,
-                    "stopped",
-                    f"state became non-finite at t = {solver.t:.6g} s",
-                    nsteps,
-                    solver.njev,
-                )
-            if k < len(t_eval) and t_eval[k] <= solver.t:
-                dense = solver.dense_output()
-                while k < len(t_eval) and t_eval[k] <= solver.t:
-                    out.append(dense(t_eval[k]))
-                    k += 1
-        return out, "ok", "", nsteps, solver.njev
-    except _OutOfTime:
-        return (
-            out,
-            "stopped",
-            f"wall-time budget exhausted at t = {t_eval[k - 1]:.6g} s",
-            nsteps,
-            getattr(solver, "njev", 0),
+        except (ValueError, np.linalg.LinAlgError):  # e.g. the LU of a NaN Jacobian
+            if f.bad_t is None:
+                raise
+            solver.status = "failed"
+        run.njev = solver.njev
+        if solver.status == "failed":
+            if f.bad_t is not None:  # blame the cause, not the symptom ("step too small")
+                raise _Stop(f"the right-hand side became non-finite at t = {f.bad_t:.6g} s")
+            raise _Stop(f"solver failed at t = {solver.t:.6g} s: {message}")
+        run.nsteps += 1
+        if not _finite(solver.y):
+            raise _Stop(f"state became non-finite at t = {solver.t:.6g} s")
+        j = (
+            len(t_eval)
+            if solver.status == "finished"
+            else np.searchsorted(t_eval, solver.t, "right")
         )
-    except (FloatingPointError, OverflowError, ZeroDivisionError, ValueError) as exc:
-        return out, "stopped", f"{type(exc).__name__} near t = {t_eval[k - 1]:.6g} s", 0, 0
+        if j > k:
+            for y in solver.dense_output()(t_eval[k:j]).T:
+                if not _finite(y):
+                    raise _Stop(f"state became non-finite at t = {t_eval[k]:.6g} s")
+                run.out.append(y)
+                k += 1
 
 
-def _fortran(f, y0, t_eval, rtol, atol, max_steps):
-    """scipy's `ode('dop853')`: the Fortran integrator lands on each output time in turn."""
+_DOP853_CODES = {
+    -1: "input is not consistent",
+    -2: "step budget exhausted",
+    -3: "step size became too small",
+    -4: "the problem is probably stiff",
+}
+
+
+def _fortran(run: _Run, f: _Counted, y0, t_eval, rtol, atol, max_steps) -> None:
+    """scipy's ``ode('dop853')`` lands on each output time in turn; budgets are checked after
+    every accepted step by its `solout` hook (returning -1 interrupts the Fortran loop)."""
+    f.watch = f.fortran = True
+
+    def solout(t: float, y: np.ndarray) -> int:
+        return -1 if f.failure is not None or not _finite(y) else 0
+
     solver = si.ode(f).set_integrator("dop853", rtol=rtol, atol=atol, nsteps=max_steps)
+    solver.set_solout(solout)
     solver.set_initial_value(y0, t_eval[0])
-    out = [y0.copy()]
-    nsteps = 0
-    try:
-        for t1 in t_eval[1:]:
+    for t1 in t_eval[1:]:
+        if run.nsteps >= max_steps:
+            raise _Stop(f"step budget ({max_steps}) exhausted at t = {solver.t:.6g} s")
+        solver._integrator.call_args[6] = max_steps - run.nsteps  # NMAX of this call
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the failure is reported in the message instead
             y = solver.integrate(t1)
-            nsteps += int(solver._integrator.iwork[17])  # NSTEP of this call: IWORK(18)
-            if not solver.successful():
-                return out, "stopped", f"dop853 failed near t = {solver.t:.6g} s", nsteps
-            if not np.all(np.isfinite(y)):
-                return out, "stopped", f"state became non-finite at t ≈ {t1:.6g} s", nsteps
-            out.append(y.copy())
-        return out, "ok", "", nsteps
-    except _OutOfTime:
-        at = t_eval[len(out) - 1]
-        return out, "stopped", f"wall-time budget exhausted at t = {at:.6g} s", nsteps
-
-
-def _fixed(method, f, y0, t_eval, dt, max_steps, n):
-    """Land exactly on every output time: each interval gets ⌈Δt/dt⌉ equal steps of ≤ dt."""
-    n = len(y0) // 2 if n is None else n
-    step = _STEPPERS[method]
-    y = y0.copy()
-    out = [y.copy()]
-    nsteps = 0
-    try:
-        for k in range(1, len(t_eval)):
-            t0, t1 = t_eval[k - 1], t_eval[k]
-            m = max(1, math.ceil((t1 - t0) / dt - 1e-9))
-            h = (t1 - t0) / m
-            for i in range(m):
-                y = step(f, t0 + i * h, y, h, n)
-                nsteps += 1
-            if not np.all(np.isfinite(y)):
-                return out, "stopped", f"state became non-finite at t ≈ {t1:.6g} s", nsteps
-            if nsteps > max_steps:
-                return (
-                    out,
-                    "stopped",
-                    f"step budget ({max_steps}) exhausted at t = {t1:.6g} s",
-                    nsteps,
-                )
-            out.append(y.copy())
-        return out, "ok", "", nsteps
-    except _OutOfTime:
-        return (
-            out,
-            "stopped",
-            f"wall-time budget exhausted at t = {t_eval[len(out) - 1]:.6g} s",
-            nsteps,
-        )
-    except (FloatingPointError, OverflowError, ZeroDivisionError) as exc:
-        return out, "stopped", f"{type(exc).__name__} near t = {t_eval[len(out) - 1]:.6g} s", nsteps
+        run.nsteps += int(solver._integrator.iwork[17])  # NSTEP of this call: IWORK(18)
+        if f.failure is not None:
+            raise f.failure
+        if not _finite(y):
+            raise _Stop(f"state became non-finite at t = {solver.t:.6g} s")
+        code = solver.get_return_code()
+        if code < 0:
+            if code == -2:
+                raise _Stop(f"step budget ({max_steps}) exhausted at t = {solver.t:.6g} s")
+            raise _Stop(f"dop853 failed at t = {solver.t:.6g} s: {_DOP853_CODES.get(code)}")
+        run.out.append(np.array(y))
 
 
 def _euler(f, t, y, h, n):
+    """y ← y + h f(t, y): order 1; energy of oscillators grows by a factor (1 + h²ω²) a step."""
     return y + h * f(t, y)
 
 
 def _symplectic_euler(f, t, y, h, n):
-    """v ← v + h a(q, v); q ← q + h v_new; extra states by the same explicit slope."""
-    d = f(t, y)
-    new = y + h * d
+    """v ← v + h a(q, v); q ← q + h v_new (extra states: explicit Euler). Order 1, symplectic."""
+    new = y + h * f(t, y)
     new[:n] = y[:n] + h * new[n : 2 * n]
     return new
 
 
 def _rk4(f, t, y, h, n):
+    """Classical Runge–Kutta: order 4, four evaluations, not symplectic (energy drifts)."""
     k1 = f(t, y)
     k2 = f(t + h / 2, y + h / 2 * k1)
     k3 = f(t + h / 2, y + h / 2 * k2)
@@ -329,28 +327,46 @@ def _rk4(f, t, y, h, n):
 
 
 def _implicit_midpoint(f, t, y, h, n):
-    """y1 = y + h f(t + h/2, (y + y1)/2), by fixed point, then Newton if that stalls."""
-    y1 = y + h * f(t, y)
+    """y1 = y + h f(t + h/2, (y + y1)/2): order 2, symplectic, A-stable, time-reversible.
+
+    Fixed-point iteration (it contracts when h·|∂f/∂y|/2 < 1) to 1e-14 relative; if it has not
+    converged in 50 iterations or diverges (stiff problems), Newton's method with a
+    finite-difference Jacobian, started again from the explicit Euler guess.
+    """
+    tm = t + h / 2
+    tol = 1e-14 * (1.0 + np.abs(y).max())
+    guess = z = y + h * f(t, y)
+    last = math.inf
     for _ in range(50):
-        nxt = y + h * f(t + h / 2, (y + y1) / 2)
-        if np.max(np.abs(nxt - y1)) <= 1e-14 * (1 + np.max(np.abs(nxt))):
-            return nxt
-        y1 = nxt
-    for _ in range(20):  # Newton on g(z) = z - y - h f(t + h/2, (y + z)/2)
-        mid = (y + y1) / 2
-        g = y1 - y - h * f(t + h / 2, mid)
-        eps = 1e-8
-        J = np.eye(len(y))
-        base = f(t + h / 2, mid)
-        for j in range(len(y)):
-            dm = mid.copy()
-            dm[j] += eps
-            J[:, j] -= h / 2 * (f(t + h / 2, dm) - base) / eps
-        delta = np.linalg.solve(J, -g)
-        y1 = y1 + delta
-        if np.max(np.abs(delta)) <= 1e-14 * (1 + np.max(np.abs(y1))):
+        nxt = y + h * f(tm, (y + z) * 0.5)
+        change = np.abs(nxt - z).max()
+        z = nxt
+        rate = change / last  # contraction factor ρ: the error left is about change·ρ/(1 − ρ)
+        if change <= tol or (0 < rate < 0.5 and change * rate <= tol * (1 - rate)):
+            return z
+        if not rate < 1:  # diverging, stalled or non-finite
             break
-    return y1
+        last = change
+    z = guess
+    eye = np.eye(len(y))
+    for _ in range(25):
+        mid = (y + z) / 2
+        fm = f(tm, mid)
+        jac = np.empty((len(y), len(y)))
+        for j in range(len(y)):
+            e = 1.4901161193847656e-08 * max(1.0, abs(mid[j]))  # sqrt(machine epsilon)
+            probe = mid.copy()
+            probe[j] += e
+            jac[:, j] = (f(tm, probe) - fm) / e
+        dz = np.linalg.solve(eye - h / 2 * jac, -(z - y - h * fm))
+        z = z + dz
+        if not _finite(z):
+            return z  # the caller reports the non-finite state and when
+        if np.abs(dz).max() <= tol:
+            return z
+    if np.abs(dz).max() <= 1e4 * tol:
+        return z  # converged as far as rounding of the finite-difference Jacobian allows
+    raise _Stop(f"implicit midpoint: the step equation did not converge at t = {t:.6g} s")
 
 
 _STEPPERS = {
