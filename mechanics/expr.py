@@ -7,7 +7,7 @@ algebra runs, so hostile input (``9**9**9**9``, 100 kB strings, deep nesting) fa
 microseconds instead of tying up a server worker.
 
 Decimals: a literal with an integral value below 1e15 (``2.0``, ``1e6``) becomes an Integer; one
-with at most 6 significant digits and magnitude at least 1e-6 becomes an exact Rational (``0.5`` ->
+with at most 6 significant digits and size in [1e-6, 1e30) becomes an exact Rational (``0.5`` ->
 1/2, ``9.81`` -> 981/100) so derivations print as textbooks do (``m*g*l/2``); any other decimal
 stays a 15-digit ``sympy.Float``. Python ints and floats handed to `parse` follow the same rules.
 """
@@ -115,7 +115,9 @@ def _number(value: object, field: str, position: int | None = None) -> sp.Expr:
     if value.is_integer() and abs(value) < 1e15:
         return sp.Integer(int(value))
     decimal = Decimal(repr(value))
-    if len(decimal.normalize().as_tuple().digits) <= 6 and abs(value) >= 1e-6:
+    # Only what an integer literal could also write exactly: 1e300 as an exact 10**300 makes
+    # sympy's trig reductions raise TypeError/AttributeError instead of ExprError.
+    if len(decimal.normalize().as_tuple().digits) <= 6 and 1e-6 <= abs(value) < 10.0**MAX_DIGITS:
         exact = Fraction(decimal)
         return sp.Rational(exact.numerator, exact.denominator)
     return sp.Float(repr(value), 15)
@@ -128,6 +130,17 @@ def _magnitude(value: sp.Expr) -> float:
     except (TypeError, ValueError, OverflowError, ArithmeticError):
         return math.inf
     return size if math.isfinite(size) else math.inf
+
+
+def _real(value: sp.Expr) -> bool:
+    """Is a closed-form number real? Decided numerically: sympy's assumptions can be slow."""
+    if value.is_Rational or value.is_Float:
+        return True
+    try:
+        z = complex(value.evalf(15))
+    except (TypeError, ValueError, OverflowError, ArithmeticError):
+        return False
+    return abs(z.imag) <= 1e-12 * max(1.0, abs(z.real))
 
 
 def _precheck(text: object, field: str) -> tuple[str, int]:
@@ -268,6 +281,10 @@ class _Builder:
         for part in parts:
             if part.is_number and _magnitude(part) > MAX_MAGNITUDE:
                 raise self.error("not a finite number", node)
+            if part.is_number and not _real(part):
+                # acos(65) is complex: meaningless in mechanics, and sympy can spend minutes
+                # on expressions built from such constants (atan2(acos(65), 0)).
+                raise self.error("not a real number", node)
         return value
 
     def name(self, node: ast.Name) -> sp.Expr:
@@ -310,6 +327,9 @@ class _Builder:
             plural = "s" if arity > 1 else ""
             raise self.error(f"{name}() takes {arity} argument{plural}, not {len(node.args)}", node)
         args = [self.build(arg, depth + 1) for arg in node.args]
+        if name == "atan2" and any(a.is_number and a.is_extended_real is False for a in args):
+            # sympy's atan2(acos(65), 0) grinds for minutes deciding the sign of i*acosh(65).
+            raise self.error("atan2() takes real arguments", node)
         return self.finite(FUNCTIONS[name](*args), node)
 
 
