@@ -48,8 +48,10 @@ def scene_page(request: Request, scene_id: str) -> HTMLResponse:
         return templates.TemplateResponse(
             request, "404.html", {"what": f"There is no scene '{scene_id}'."}, status_code=404
         )
-    title = next(s["title"] for s in list_scenes() if s["id"] == scene_id)
-    return _page(request, "scene.html", scene_id=scene_id, title=title)
+    entry = next(s for s in list_scenes() if s["id"] == scene_id)
+    return _page(
+        request, "scene.html", scene_id=scene_id, title=entry["title"], summary=entry["summary"]
+    )
 
 
 @router.get("/editor", response_class=HTMLResponse)

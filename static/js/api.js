@@ -1,4 +1,6 @@
 // Thin wrappers over /api/v1: every failure becomes an Error carrying the API's field details.
+// The page counts requests in flight on <html data-pending>, so a test (or a person) can tell
+// when it has settled.
 
 export class ApiError extends Error {
   constructor(status, detail) {
@@ -11,28 +13,41 @@ export class ApiError extends Error {
   }
 }
 
-export async function getJSON(url) {
-  const r = await fetch(url);
-  const body = await r.json().catch(() => ({}));
-  if (!r.ok) throw new ApiError(r.status, body.detail ?? r.statusText);
-  return body;
+function pending(delta) {
+  const root = document.documentElement;
+  root.dataset.pending = String(Number(root.dataset.pending || 0) + delta);
 }
 
-export async function postJSON(url, payload, { signal } = {}) {
-  const r = await fetch(url, {
+async function call(url, init) {
+  pending(+1);
+  try {
+    const r = await fetch(url, init);
+    const body = await r.json().catch(() => ({}));
+    if (!r.ok) throw new ApiError(r.status, body.detail ?? r.statusText);
+    return body;
+  } finally {
+    pending(-1);
+  }
+}
+
+export function getJSON(url) {
+  return call(url);
+}
+
+export function postJSON(url, payload, { signal } = {}) {
+  return call(url, {
     method: "POST",
     headers: { "content-type": "application/json" },
     body: JSON.stringify(payload),
     signal,
   });
-  const body = await r.json().catch(() => ({}));
-  if (!r.ok) throw new ApiError(r.status, body.detail ?? r.statusText);
-  return body;
 }
 
+/** Render the LaTeX inside `elements` with MathJax (pages without it keep the source). */
 export async function typeset(elements) {
-  // MathJax renders the LaTeX in place; pages without it simply show the source.
-  if (!window.MathJax) return;
-  await window.MathJax.startup.promise;
-  await window.MathJax.typesetPromise(elements);
+  const mj = window.MathJax;
+  if (!mj || !mj.startup) return;
+  await mj.startup.promise;
+  mj.typesetClear?.(elements);
+  await mj.typesetPromise(elements);
 }

@@ -1,48 +1,124 @@
-// The spec editor: write or paste a scene spec, derive it, see errors next to their fields,
-// then simulate and animate it like a built-in scene.
+// The spec editor: write or paste a scene spec, derive it, see each error beside the line of the
+// field it names (the API's field paths, found in the text), then simulate and animate it like a
+// built-in scene with the same modules.
 import { ApiError, getJSON, postJSON } from "./api.js";
+import { lineOf, locate } from "./jsonpath.js";
 import { mountScene } from "./scene.js";
 
 const $ = (id) => document.getElementById(id);
+const LINE = 20; // px, as in app.css (.code textarea line-height)
 let view = null;
+let marks = [];
 
 export async function mountEditor() {
   const query = new URLSearchParams(location.search);
   const start = query.get("from") || "simple_pendulum";
-  $("template").value = start;
-  await load(start);
+  if ([...$("template").options].some((o) => o.value === start)) $("template").value = start;
+  const area = $("spec");
+  area.addEventListener("input", () => { numberLines(); });
+  area.addEventListener("scroll", syncScroll);
+  area.addEventListener("keydown", (e) => {
+    e.stopPropagation(); // typing is not a lecture-mode shortcut
+    if (e.key === "Enter" && (e.ctrlKey || e.metaKey)) { e.preventDefault(); derive(); }
+  });
   $("load-template").addEventListener("click", () => load($("template").value));
   $("derive").addEventListener("click", derive);
+  await load(start);
 }
 
 async function load(id) {
   const { spec } = await getJSON(`/api/v1/scenes/${id}`);
   $("spec").value = JSON.stringify(spec, null, 2);
-  $("spec-errors").replaceChildren();
-  $("spec").classList.remove("has-error");
+  showErrors([]);
+  $("errors-empty").textContent = "None found yet: press “Derive and simulate”.";
+}
+
+function numberLines() {
+  const n = $("spec").value.split("\n").length;
+  const gutter = $("gutter");
+  if (gutter.childElementCount !== n) {
+    gutter.replaceChildren(...Array.from({ length: n }, (_, k) => Object.assign(document.createElement("div"), { textContent: k + 1 })));
+  }
+  const bad = new Set(marks.flatMap((m) => m.lines));
+  [...gutter.children].forEach((d, k) => d.classList.toggle("error", bad.has(k + 1)));
+  syncScroll();
+}
+
+function syncScroll() {
+  const area = $("spec");
+  $("gutter").scrollTop = area.scrollTop;
+  const inner = $("line-marks").firstElementChild;
+  if (inner) inner.style.transform = `translate(${-area.scrollLeft}px, ${-area.scrollTop}px)`;
+}
+
+/** Where a field is in the text: its lines (at most six) and its first character. */
+function place(field) {
+  const text = $("spec").value;
+  const at = locate(text, field);
+  if (!at) return { lines: [1], start: 0, end: 0 };
+  const first = lineOf(text, at.start), last = Math.min(lineOf(text, at.end), first + 5);
+  return { lines: Array.from({ length: last - first + 1 }, (_, k) => first + k), start: at.start, end: at.end };
 }
 
 function showErrors(items) {
-  $("spec").classList.toggle("has-error", items.length > 0);
-  $("spec-errors").replaceChildren(...items.map(({ field, message }) => {
+  marks = items.map((e) => ({ ...e, ...place(e.field) }));
+  $("code").classList.toggle("has-error", marks.length > 0);
+  $("errors-empty").hidden = marks.length > 0;
+  $("errors-empty").textContent = "No problems: derived.";
+  $("spec-errors").replaceChildren(...marks.map((m) => {
     const li = document.createElement("li");
-    li.dataset.field = field;
-    li.innerHTML = "<code></code>: <span></span>";
-    li.querySelector("code").textContent = field || "spec";
-    li.querySelector("span").textContent = message;
+    li.dataset.field = m.field;
+    li.innerHTML = '<code></code>: <span class="message"></span><span class="where"></span>';
+    li.querySelector("code").textContent = m.field || "spec";
+    li.querySelector(".message").textContent = m.message;
+    li.querySelector(".where").textContent = `line ${m.lines[0]}`;
+    li.title = "show it in the spec";
+    li.addEventListener("click", () => reveal(m));
     return li;
   }));
-  const first = items[0];
-  if (first) highlight(first.field);
+  const inner = document.createElement("div");
+  inner.className = "inner";
+  inner.append(...marks.flatMap((m) => m.lines.map((line, k) => {
+    const div = document.createElement("div");
+    div.className = "mark";
+    div.style.top = `${10 + (line - 1) * LINE}px`;
+    div.dataset.field = m.field;
+    if (k === 0) {
+      const note = Object.assign(document.createElement("span"), { textContent: `← ${m.field}: ${m.message}` });
+      const text = $("spec").value.split("\n")[line - 1] || "";
+      note.style.left = `${10 + (text.length + 2) * charWidth()}px`;
+      div.append(note);
+    }
+    return div;
+  })));
+  $("line-marks").replaceChildren(inner);
+  numberLines();
+  if (marks.length) reveal(marks[0], false);
 }
 
-function highlight(field) {
-  // Select the line of the JSON that holds the last named key of the field path.
-  const key = (field.match(/([A-Za-z_]\w*)(?:\[\d+\])*$/) || [])[1];
-  if (!key) return;
+function charWidth() {
+  const ctx = document.createElement("canvas").getContext("2d");
+  ctx.font = getComputedStyle($("spec")).font;
+  return ctx.measureText("0000000000").width / 10;
+}
+
+function reveal(m, focus = true) {
+  const area = $("spec");
+  area.scrollTop = Math.max(0, (m.lines[0] - 4) * LINE);
+  if (focus) {
+    area.focus({ preventScroll: true });
+    area.setSelectionRange(m.start, m.end);
+    area.scrollTop = Math.max(0, (m.lines[0] - 4) * LINE);
+  }
+  syncScroll();
+}
+
+function jsonError(err) {
   const text = $("spec").value;
-  const at = text.indexOf(`"${key}"`);
-  if (at >= 0) $("spec").setSelectionRange(at, text.indexOf("\n", at));
+  const m = err.message.match(/position (\d+)/) || [];
+  const lc = err.message.match(/line (\d+) column (\d+)/);
+  const line = lc ? Number(lc[1]) : m[1] ? lineOf(text, Number(m[1])) : 1;
+  return { field: "JSON", message: err.message, line };
 }
 
 async function derive() {
@@ -50,20 +126,33 @@ async function derive() {
   try {
     spec = JSON.parse($("spec").value);
   } catch (err) {
-    showErrors([{ field: "JSON", message: err.message }]);
+    const e = jsonError(err);
+    showErrors([{ field: e.field, message: e.message }]);
+    marks[0].lines = [e.line];
+    $("spec-errors").querySelector(".where").textContent = `line ${e.line}`;
+    $("line-marks").querySelector(".mark").style.top = `${10 + (e.line - 1) * LINE}px`;
+    numberLines();
     return;
   }
   $("editor-status").textContent = "deriving…";
+  $("derive").disabled = true;
+  let derivation;
   try {
-    await postJSON("/api/v1/derive", { scene: spec });
+    derivation = await postJSON("/api/v1/derive", { scene: spec });
   } catch (err) {
     $("editor-status").textContent = "";
-    showErrors(err instanceof ApiError && Array.isArray(err.detail) ? err.detail : [{ field: "", message: err.message }]);
+    $("result").hidden = true;
+    const detail = err instanceof ApiError && Array.isArray(err.detail)
+      ? err.detail.map((d) => ({ ...d, field: d.field.replace(/^scene(\.|$)/, "") }))
+      : [{ field: "", message: err.message }];
+    showErrors(detail);
     return;
+  } finally {
+    $("derive").disabled = false;
   }
   showErrors([]);
-  $("editor-status").textContent = "derived";
+  $("editor-status").textContent = `derived in ${(derivation.seconds ?? 0).toFixed(2)} s`;
   $("result").hidden = false;
-  if (view) await view.load(spec);
-  else view = await mountScene({ spec });
+  if (view) await view.load(spec, new URLSearchParams(), derivation);
+  else view = await mountScene({ spec, derivation });
 }

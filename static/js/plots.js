@@ -1,45 +1,67 @@
-// q(t), phase portraits and energies with plotly (served by the app, no CDN).
+// q(t), the phase portrait of one coordinate (q_j against q̇_j), and the energies T, V, E (and the
+// work W_NC of non-conservative forces) against time, with plotly served by the app (no CDN).
+// In compare mode the energy plot shows both runs' energy error instead.
 
-const LAYOUT = {
-  margin: { l: 55, r: 15, t: 36, b: 42 },
-  legend: { orientation: "h", y: -0.25 },
-  font: { size: 12 },
-};
+const CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["select2d", "lasso2d"] };
 
-function ready() {
-  return typeof window.Plotly !== "undefined";
+function layout(title, x, y, lecture) {
+  const ink = lecture ? "#f1f3f5" : "#1d2430";
+  const grid = lecture ? "#333" : "#e9ecef";
+  return {
+    title: { text: title, font: { size: lecture ? 20 : 14 } },
+    margin: { l: 62, r: 14, t: 40, b: 48 },
+    legend: { orientation: "h", y: -0.3, x: 0, font: { size: lecture ? 14 : 11 } },
+    font: { size: lecture ? 16 : 12, color: ink },
+    paper_bgcolor: "rgba(0,0,0,0)",
+    plot_bgcolor: "rgba(0,0,0,0)",
+    xaxis: { title: { text: x }, gridcolor: grid, zerolinecolor: grid },
+    yaxis: { title: { text: y }, gridcolor: grid, zerolinecolor: grid, exponentformat: "power" },
+  };
 }
 
-export function plotRun(result, compare, labels) {
-  if (!ready()) return;
-  const names = Object.keys(result.q);
-  const t = result.t;
-  window.Plotly.react("plot-q", names.map((n) => ({ x: t, y: result.q[n], name: n, mode: "lines" })),
-    { ...LAYOUT, title: { text: "q(t)" }, xaxis: { title: "t (s)" } }, { responsive: true, displaylogo: false });
-  window.Plotly.react("plot-phase",
-    names.map((n) => ({ x: result.q[n], y: result.q_dot[n], name: `${n}, ${n}_dot`, mode: "lines" })),
-    { ...LAYOUT, title: { text: "phase portrait" }, xaxis: { title: "q" }, yaxis: { title: "q̇" } },
-    { responsive: true, displaylogo: false });
-  const e = result.energy;
-  const traces = [
-    { x: t, y: e.T, name: "T", mode: "lines" },
-    { x: t, y: e.V, name: "V", mode: "lines" },
-    { x: t, y: e.E, name: "E = T + V", mode: "lines" },
-  ];
-  if (e.W_nc.some((w) => Math.abs(w) > 1e-12)) {
-    traces.push({ x: t, y: e.W_nc, name: "W_NC", mode: "lines", line: { dash: "dot" } });
-  }
+export const plotlyReady = () => typeof window.Plotly !== "undefined";
+
+function unitOf(units, q) {
+  return units && units[q] ? ` (${units[q]})` : "";
+}
+
+/** Draw the three plots for run `a` (and `b` when comparing). */
+export function plotRun({ a, b, labels, spec, phase, lecture }) {
+  if (!plotlyReady()) return;
+  const P = window.Plotly;
+  const names = Object.keys(a.q);
+  const units = spec.units || {};
+  const t = a.t;
+  const same = new Set(names.map((n) => units[n] || "")).size === 1;
+  const yq = same && units[names[0]] ? `q (${units[names[0]]})` : "q";
+  P.react("plot-q", names.map((n) => ({ x: t, y: a.q[n], name: n, mode: "lines", line: { width: 2 } })),
+    layout("coordinates q(t)", "t (s)", yq, lecture), CONFIG);
+  const q = names.includes(phase) ? phase : names[0];
+  const traces = [{ x: a.q[q], y: a.q_dot[q], name: b ? `A: ${labels[0]}` : q, mode: "lines", line: { width: 1.8 } }];
+  if (b) traces.push({ x: b.q[q], y: b.q_dot[q], name: `B: ${labels[1]}`, mode: "lines", line: { width: 1.4, dash: "dot" } });
+  traces.push({ x: [a.q[q][0]], y: [a.q_dot[q][0]], name: "start", mode: "markers", marker: { size: 9, color: "#d9480f" } });
+  const uq = units[q];
+  P.react("plot-phase", traces,
+    layout(`phase portrait of ${q}`, `${q}${unitOf(units, q)}`, `${q}_dot${uq ? ` (${uq}/s)` : ""}`, lecture), CONFIG);
+  const e = a.energy;
+  let energy;
   let title = "energy";
-  if (compare) {
+  if (b) {
     const err = (r) => {
       const maxT = Math.max(...r.energy.T.map(Math.abs), 1e-300);
       return r.energy.E.map((v, i) => (v - r.energy.E[0] - r.energy.W_nc[i]) / maxT);
     };
-    traces.length = 0;
-    traces.push({ x: t, y: err(result), name: labels[0], mode: "lines" });
-    traces.push({ x: compare.t, y: err(compare), name: labels[1], mode: "lines" });
+    energy = [{ x: t, y: err(a), name: `A: ${labels[0]}`, mode: "lines" }, { x: b.t, y: err(b), name: `B: ${labels[1]}`, mode: "lines" }];
     title = "energy error (E − E₀ − W_NC) / max T";
+  } else {
+    energy = [
+      { x: t, y: e.T, name: "T", mode: "lines" },
+      { x: t, y: e.V, name: "V", mode: "lines" },
+      { x: t, y: e.E, name: "E = T + V", mode: "lines", line: { width: 3 } },
+    ];
+    if (e.W_nc.some((w) => Math.abs(w) > 1e-12)) {
+      energy.push({ x: t, y: e.W_nc, name: "W_NC", mode: "lines", line: { dash: "dot" } });
+    }
   }
-  window.Plotly.react("plot-energy", traces,
-    { ...LAYOUT, title: { text: title }, xaxis: { title: "t (s)" } }, { responsive: true, displaylogo: false });
+  P.react("plot-energy", energy, layout(title, "t (s)", b ? "relative error" : "J", lecture), CONFIG);
 }

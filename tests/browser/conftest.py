@@ -1,4 +1,9 @@
-"""A real server and Debian's Chromium, driven by Playwright, for tests that use the pages."""
+"""A real server and Debian's Chromium, driven by Playwright, for tests that use the pages.
+
+One server and one browser for the whole session; one page, reused by every test, with its
+console errors, failed requests and requests to other hosts collected (the pages must work
+offline: MathJax and plotly come from the app).
+"""
 
 from __future__ import annotations
 
@@ -9,11 +14,13 @@ import sys
 import time
 import urllib.request
 from pathlib import Path
+from urllib.parse import urlparse
 
 import pytest
 
 CHROMIUM = "/usr/bin/chromium"
 ARTIFACTS = Path(__file__).resolve().parent.parent / "artifacts"
+ROOT = Path(__file__).resolve().parents[2]
 
 if not Path(CHROMIUM).exists():  # CI installs it; a bare laptop skips with a reason
     pytest.skip(
@@ -29,21 +36,11 @@ def _free_port() -> int:
 
 @pytest.fixture(scope="session")
 def server(tmp_path_factory) -> str:
+    """The app under uvicorn in a subprocess, with its derivation cache in a fresh folder."""
     port = _free_port()
     env = {**os.environ, "LAGRANGE_LAB_CACHE": str(tmp_path_factory.mktemp("cache"))}
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "uvicorn",
-            "app.main:app",
-            "--port",
-            str(port),
-            "--log-level",
-            "warning",
-        ],
-        env=env,
-    )
+    command = [sys.executable, "-m", "uvicorn", "app.main:app", "--port", str(port)]
+    proc = subprocess.Popen([*command, "--log-level", "warning"], env=env, cwd=ROOT)
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 60
     while True:
@@ -85,27 +82,56 @@ def browser():
 
 
 class Watched:
-    """A page with its console errors and failed requests collected."""
+    """A page with its console errors, failed requests and off-site requests collected."""
 
-    def __init__(self, page) -> None:
+    def __init__(self, page, origin: str) -> None:
         self.page = page
         self.errors: list[str] = []
+        host = urlparse(origin).netloc
         page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
-        page.on("pageerror", lambda e: self.errors.append(str(e)))
-        page.on("requestfailed", self._failed)
+        page.on("pageerror", lambda e: self.errors.append(f"page error: {e}"))
+        page.on(
+            "requestfailed",
+            lambda r: self.errors.append(f"request failed: {r.url} ({r.failure})"),
+        )
+        page.on(
+            "request",
+            lambda r: (
+                urlparse(r.url).scheme in ("http", "https")
+                and urlparse(r.url).netloc != host
+                and self.errors.append(f"off-site request: {r.url}")
+            ),
+        )
 
-    def _failed(self, request) -> None:
-        # A request cut off by the test navigating away is not a failure of the page.
-        if "ERR_ABORTED" not in (request.failure or ""):
-            self.errors.append(f"request failed: {request.url} ({request.failure})")
+    def settle(self, timeout: float = 60_000) -> None:
+        """Wait until no API request is in flight (before leaving or reloading the page)."""
+        self.page.wait_for_function(
+            "(document.documentElement.dataset.pending || '0') === '0'", timeout=timeout
+        )
+
+
+@pytest.fixture(scope="session")
+def context(browser, server):
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900})
+    ctx.grant_permissions(["clipboard-read", "clipboard-write"], origin=server)
+    yield ctx
+    ctx.close()
+
+
+@pytest.fixture(scope="session")
+def _session_page(context, server):
+    return Watched(context.new_page(), server)
 
 
 @pytest.fixture
-def page(browser):
-    context = browser.new_context(viewport={"width": 1300, "height": 900})
-    watched = Watched(context.new_page())
-    yield watched
-    context.close()
+def page(_session_page):
+    """The session's page, its error lists emptied for this test."""
+    _session_page.errors.clear()
+    yield _session_page
+    try:
+        _session_page.settle(timeout=30_000)
+    except Exception:  # a failed test may leave the page anywhere; the next goto recovers
+        pass
 
 
 @pytest.fixture(scope="session")

@@ -2,54 +2,106 @@
 
 from __future__ import annotations
 
+import json
 from urllib.parse import parse_qs, urlparse
 
 import pytest
 
-from mechanics.scenes import load_scene, scene_ids
+from mechanics.scenes import list_scenes, scene_ids
 
 pytestmark = pytest.mark.browser
 
-RAW_LATEX = ("\\frac", "\\dot", "\\hat", "\\[", "\\vec")
+#: LaTeX source that must not be left visible once MathJax has rendered the page.
+RAW_LATEX = ("\\frac", "\\dot", "\\vec", "\\hat", "\\left", "\\[", "\\(")
+
+#: A cheap fingerprint of what a canvas shows.
+CANVAS_SUM = """id => {
+  const c = document.getElementById(id);
+  const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  let s = 0;
+  for (let i = 0; i < d.length; i += 7) s = (s * 31 + d[i]) % 1000000007;
+  return s;
+}"""
 
 
-def wait_ready(page, timeout=60_000):
-    page.wait_for_selector("#steps[data-typeset='1']", timeout=timeout)
-    page.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=timeout)
+def wait_ready(page, timeout=90_000):
+    """The derivation is typeset, a simulation has arrived and nothing is in flight."""
+    page.page.wait_for_selector("#steps[data-typeset='1']", state="attached", timeout=timeout)
+    page.page.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=timeout)
+    page.settle(timeout)
+
+
+def last_q(p):
+    return json.loads(p.get_attribute("#canvas", "data-last-q"))
 
 
 @pytest.mark.parametrize("scene_id", scene_ids())
-def test_scene_page_renders_animates_and_reacts(server, page, artifacts, scene_id):
+def test_scene_page_renders_animates_reacts_and_round_trips(server, page, artifacts, scene_id):
     p = page.page
     p.goto(f"{server}/scenes/{scene_id}")
-    wait_ready(p)
-    # the math is rendered, not left as LaTeX source
+    wait_ready(page)
+
+    # the math is rendered by MathJax, and no LaTeX source is left in view
     assert p.locator("#steps mjx-container").count() > 5
-    text = p.inner_text("#steps")
-    assert not [s for s in RAW_LATEX if s in text]
-    # the canvas advances
-    first = p.get_attribute("#canvas", "data-frame")
-    p.wait_for_timeout(700)
-    assert p.get_attribute("#canvas", "data-frame") != first
-    # moving a control re-runs the simulation and changes the trajectory
-    before = p.get_attribute("#canvas", "data-last-q")
-    q = load_scene(scene_id)["coordinates"][0]
-    box = p.locator(f"#n-{q}")
-    new_value = float(box.input_value()) + 0.2
-    box.fill(str(new_value))
-    box.dispatch_event("change")
+    text = p.inner_text("body")
+    assert [s for s in RAW_LATEX if s in text] == []
+    # the free-body diagram shows forces, the plots are drawn, the stats read out
+    assert int(p.get_attribute("#fbd-svg", "data-arrows")) >= 1
+    assert p.locator("#plot-q .main-svg").count() > 0
+    assert p.locator("#plot-energy .main-svg").count() > 0
+    assert "DOP853" in p.inner_text("#stats")
+
+    # the canvas advances: another frame, other pixels
+    frame, pixels = p.get_attribute("#canvas", "data-frame"), p.evaluate(CANVAS_SUM, "canvas")
+    p.wait_for_timeout(500)
+    assert p.get_attribute("#canvas", "data-frame") != frame
+    assert p.evaluate(CANVAS_SUM, "canvas") != pixels
+
+    # moving a slider re-runs the simulation and changes the trajectory
+    spec = next(s for s in list_scenes() if s["id"] == scene_id)
+    q = spec["coordinates"][0]
+    before, run = last_q(p), p.get_attribute("#canvas", "data-run")
+    slider = p.locator(f"#s-{q}")
+    box = slider.bounding_box()
+    low, high = (float(slider.get_attribute(a)) for a in ("min", "max"))
+    at = 0.25 if float(slider.input_value()) > (low + high) / 2 else 0.85
+    slider.click(position={"x": box["width"] * at, "y": box["height"] / 2})
     p.wait_for_function(
-        "before => document.querySelector('#canvas').dataset.lastQ !== before",
-        arg=before,
-        timeout=30_000,
+        "run => document.querySelector('#canvas').dataset.run !== run", arg=run, timeout=60_000
     )
-    # the URL keeps the state, and a fresh load reproduces it
+    wait_ready(page)
+    moved = float(p.input_value(f"#n-{q}"))
+    assert last_q(p) != before
+
+    # the URL keeps the state ...
     state = parse_qs(urlparse(p.url).query)
-    assert float(state[q][0]) == pytest.approx(new_value)
-    p.screenshot(path=str(artifacts / f"{scene_id}.png"), full_page=False)
+    assert float(state[q][0]) == moved
+    assert state["method"] == ["DOP853"]
+    p.screenshot(path=str(artifacts / f"{scene_id}.png"))
+
+    # ... and a fresh load from it reproduces the same run exactly
+    after = last_q(p)
     p.goto(p.url)
-    wait_ready(p)
-    assert float(p.locator(f"#n-{q}").input_value()) == pytest.approx(new_value)
+    wait_ready(page)
+    assert float(p.input_value(f"#n-{q}")) == moved
+    assert last_q(p) == after
+    assert page.errors == []
+
+
+def test_a_shared_link_sets_every_control(server, page):
+    p = page.page
+    p.goto(f"{server}/scenes/simple_pendulum?m=1.2&theta=0.5&method=rk4&dt=0.01&t_end=4")
+    wait_ready(page)
+    assert p.input_value("#n-m") == "1.2"
+    assert p.input_value("#n-theta") == "0.5"
+    assert float(p.input_value("#s-theta")) == pytest.approx(0.5, abs=0.02)
+    assert p.input_value("#method") == "rk4"
+    assert p.input_value("#dt") == "0.01"
+    assert p.input_value("#t_end") == "4"
+    assert p.is_visible("#dt-box") and not p.is_visible("#tol-box")
+    assert "rk4" in p.inner_text("#stats")
+    # a pendulum released from rest at 0.5 rad never passes 0.5 rad: the run used the link's value
+    assert abs(last_q(p)[0]) <= 0.5 + 1e-3
     assert page.errors == []
 
 
@@ -58,64 +110,118 @@ def test_catalog_lists_and_draws_every_scene(server, page, artifacts):
     p.goto(server)
     assert p.locator(".card").count() == len(scene_ids())
     p.wait_for_function(
-        "[...document.querySelectorAll('canvas[data-thumb]')].every(c => c.dataset.ready === '1')",
+        "[...document.querySelectorAll('svg[data-thumb]')].every(s => s.dataset.ready === '1')",
         timeout=120_000,
     )
+    # every drawing has its bodies in it, and every card leads to its scene
+    for scene_id in scene_ids():
+        assert (
+            p.locator(
+                f"svg[data-thumb='{scene_id}'] circle, svg[data-thumb='{scene_id}'] polygon"
+            ).count()
+            > 0
+        )
+        assert p.locator(f"a[href='/scenes/{scene_id}']").count() == 1
+    assert p.locator("header a[href='/editor']").count() == 1
+    assert p.locator("header a[href='/docs']").count() == 1
     p.screenshot(path=str(artifacts / "catalog.png"), full_page=True)
+    page.settle()
     assert page.errors == []
 
 
 def test_lecture_mode_reveals_steps_with_the_keyboard(server, page, artifacts):
     p = page.page
     p.goto(f"{server}/scenes/simple_pendulum?lecture=1")
-    wait_ready(p)
-    visible = "document.querySelectorAll('#steps .step:not(.hidden)').length"
+    wait_ready(page)
+    visible = "document.querySelectorAll('#steps > .step:not(.hidden)').length"
+    assert "lecture" in p.evaluate("document.body.className")
     assert p.evaluate(visible) == 1
     p.keyboard.press("ArrowRight")
     p.keyboard.press("Space")
-    assert p.evaluate(visible) == 3
+    p.keyboard.press("PageDown")
+    assert p.evaluate(visible) == 4
+    assert p.inner_text("#step-counter") == "step 4 of 8"
     p.keyboard.press("ArrowLeft")
+    p.keyboard.press("PageUp")
     assert p.evaluate(visible) == 2
-    assert "lecture" in p.evaluate("document.body.className")
-    playing = p.inner_text("#play")
+    playing = p.get_attribute("#play", "aria-pressed")
     p.keyboard.press("p")
-    assert p.inner_text("#play") != playing
+    assert p.get_attribute("#play", "aria-pressed") != playing
+    p.keyboard.press("p")
+    p.keyboard.press("ArrowRight")
+    p.wait_for_timeout(400)  # the smooth scroll to the new step
     p.screenshot(path=str(artifacts / "lecture.png"))
+    # the toggle leaves lecture mode: every step shows again, and the URL forgets it
+    p.click("#lecture-toggle")
+    assert "lecture" not in p.evaluate("document.body.className")
+    assert p.evaluate(visible) == 8
+    assert "lecture" not in parse_qs(urlparse(p.url).query)
     assert page.errors == []
 
 
-def test_compare_mode_shows_two_runs(server, page):
-    p = page.page
-    p.goto(f"{server}/scenes/double_pendulum?compare=1&method_b=euler&dt=0.01&t_end=5")
-    wait_ready(p)
-    assert p.is_visible("#view-b")
-    p.wait_for_function("document.querySelector('#caption-b').textContent.includes('euler')")
-    assert "B:" in p.inner_text("#stats")
-    assert page.errors == []
-
-
-def test_your_turn_box_checks_an_answer(server, page):
+def test_energy_step_copies_its_lines_and_checks_an_answer(server, page):
     p = page.page
     p.goto(f"{server}/scenes/simple_pendulum")
-    wait_ready(p)
-    box = p.locator("li[data-step='energy'] details.yourturn").first
+    wait_ready(page)
+    step = p.locator("li[data-step='energy']")
+    # a button per line copies its LaTeX, another its plain text
+    line = step.locator(".math-line").first
+    line.locator("button[data-copy='LaTeX']").click()
+    assert "\\dot{\\theta}" in p.evaluate("navigator.clipboard.readText()")
+    line.locator("button[data-copy='text']").click()
+    plain = p.evaluate("navigator.clipboard.readText()")
+    assert "theta_dot" in plain and "\\" not in plain
+    # the "your turn" box checks an answer typed in plain notation
+    box = step.locator("details.yourturn").first
     box.locator("summary").click()
     box.locator("input").fill("1/2 m l^2 theta'^2")
     box.locator("button.check").click()
+    verdict = box.locator(".verdict")
     p.wait_for_function(
         "document.querySelector(\"li[data-step='energy'] .verdict\").textContent.length > 0"
     )
-    assert "Correct" in box.locator(".verdict").inner_text()
-    box.locator("input").fill("m l^2 theta'^2")
-    box.locator("button.check").click()
-    feedback = "document.querySelector(\"li[data-step='energy'] .feedback\").textContent"
-    p.wait_for_function(f"{feedback}.includes('factor')")
+    assert "Correct" in verdict.inner_text()
+    assert page.errors == []
+
+
+def test_compare_mode_shows_two_runs_and_their_costs(server, page, artifacts):
+    p = page.page
+    p.goto(f"{server}/scenes/double_pendulum?compare=1&method_b=euler&dt=0.01&t_end=5")
+    wait_ready(page)
+    assert p.is_visible("#canvas-b")
+    assert "euler" in p.inner_text("#caption-b")
+    header = p.inner_text("#stats thead")
+    assert "A" in header and "B" in header
+    assert p.locator("#stats tbody tr").first.locator("td").count() == 2
+    frame = p.get_attribute("#canvas-b", "data-frame")
+    p.wait_for_timeout(400)
+    assert p.get_attribute("#canvas-b", "data-frame") != frame
+    assert "energy error" in p.inner_text("#plot-energy")
+    p.screenshot(path=str(artifacts / "compare.png"))
+    assert page.errors == []
+
+
+def test_a_3d_scene_turns_when_dragged(server, page):
+    p = page.page
+    p.goto(f"{server}/scenes/spherical_pendulum")
+    wait_ready(page)
+    assert p.get_attribute("#canvas", "data-view") == "3d"
+    p.click("#play")  # pause, so only the drag changes the picture
+    p.wait_for_timeout(100)
+    before = p.evaluate(CANVAS_SUM, "canvas")
+    box = p.locator("#canvas").bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    p.mouse.move(x, y)
+    p.mouse.down()
+    p.mouse.move(x + 120, y + 30, steps=5)
+    p.mouse.up()
+    assert p.evaluate(CANVAS_SUM, "canvas") != before
     assert page.errors == []
 
 
 def test_editor_shows_a_field_level_error_then_runs_a_good_spec(server, page, artifacts):
     p = page.page
-    p.goto(f"{server}/editor")
+    p.goto(f"{server}/editor?from=simple_pendulum")
     p.wait_for_function("document.querySelector('#spec').value.includes('bodies')")
     spec = p.input_value("#spec").replace('"mass": "m"', '"mass": "lenght"')
     p.fill("#spec", spec)
@@ -123,15 +229,29 @@ def test_editor_shows_a_field_level_error_then_runs_a_good_spec(server, page, ar
     error = p.locator("#spec-errors li[data-field='bodies[0].mass']")
     error.wait_for(timeout=30_000)
     assert "lenght" in error.inner_text()
+    # the line of the field is marked in the text, with the message beside it
+    line = spec.split("\n").index(next(x for x in spec.split("\n") if '"lenght"' in x)) + 1
+    assert f"line {line}" in error.inner_text()
+    assert p.inner_text("#gutter .error") == str(line)
+    mark = p.locator("#line-marks .mark[data-field='bodies[0].mass'] span")
+    assert mark.is_visible() and "lenght" in mark.inner_text()
     p.screenshot(path=str(artifacts / "editor-error.png"))
+    # a spec that is not even JSON names the line it breaks on
+    p.fill("#spec", spec.replace('"kind": "particle",', '"kind": "particle"'))
+    p.click("#derive")
+    p.locator("#spec-errors li[data-field='JSON']").wait_for()
+    # fixed, it derives and animates like a built-in scene
     p.fill("#spec", spec.replace('"mass": "lenght"', '"mass": "m"'))
     p.click("#derive")
-    wait_ready(p)
+    wait_ready(page)
     assert p.locator("#spec-errors li").count() == 0
-    # a 422 answered by the API is logged by the browser as a failed resource; nothing else
+    assert p.is_visible("#canvas")
+    assert p.locator("#steps mjx-container").count() > 5
+    # Chrome logs the API's 422 answer as a failed resource; nothing else may go wrong
     assert [e for e in page.errors if "422" not in e] == []
 
 
 def test_unknown_scene_page_is_a_404(server, page):
     response = page.page.goto(f"{server}/scenes/no_such_scene")
     assert response.status == 404
+    assert "no_such_scene" in page.page.inner_text("main")

@@ -1,0 +1,94 @@
+// A slider and a number box for every parameter and every initial q and q_dot, and the page state
+// in the URL query (?m=1.2&theta=0.5&method=rk4&dt=0.01), so a link reproduces a run exactly.
+
+const SETTINGS = ["method", "method_b", "tol", "dt", "t_end", "compare", "lecture", "phase"];
+
+/** A sensible slider range for a value: [0, 3x] for a positive parameter, ±π for an angle. */
+export function sliderRange(value, { angle = false, positive = false } = {}) {
+  let lo, hi;
+  const a = Math.abs(value);
+  if (angle) [lo, hi] = [-Math.PI, Math.PI];
+  else if (positive) [lo, hi] = [0, a > 0 ? 3 * a : 2];
+  else if (a === 0) [lo, hi] = [-2, 2];
+  else [lo, hi] = [-3 * a, 3 * a];
+  return [Math.min(lo, value), Math.max(hi, value)];
+}
+
+/** The scene's values, overridden by the query's (unknown names and non-numbers are ignored). */
+export function readValues(spec, query) {
+  const params = { ...(spec.parameters || {}) };
+  const initial = {};
+  for (const q of spec.coordinates) {
+    initial[q] = (spec.initial || {})[q] ?? 0;
+    initial[`${q}_dot`] = (spec.initial || {})[`${q}_dot`] ?? 0;
+  }
+  for (const [k, v] of query) {
+    const x = Number(v);
+    if (v === "" || !Number.isFinite(x) || SETTINGS.includes(k)) continue;
+    if (k in params) params[k] = x;
+    else if (k in initial) initial[k] = x;
+  }
+  return { params, initial };
+}
+
+/** The state as a query string: parameters, initial state, integrator settings. */
+export function writeQuery({ params, initial, settings, fixed, lecture }) {
+  const q = new URLSearchParams();
+  for (const [k, v] of Object.entries(params)) q.set(k, String(v));
+  for (const [k, v] of Object.entries(initial)) q.set(k, String(v));
+  q.set("method", settings.method);
+  if (fixed(settings.method) || (settings.compare && fixed(settings.methodB))) q.set("dt", settings.dt);
+  if (!fixed(settings.method) || (settings.compare && !fixed(settings.methodB))) q.set("tol", settings.tol);
+  q.set("t_end", String(settings.t_end));
+  if (settings.compare) {
+    q.set("compare", "1");
+    q.set("method_b", settings.methodB);
+  }
+  if (lecture) q.set("lecture", "1");
+  return q.toString();
+}
+
+/** Build the rows of sliders; `onChange(name, value)` fires on every move (the caller debounces). */
+export function buildControls(box, rows, onChange) {
+  box.replaceChildren();
+  for (const { name, value, unit, angle, positive } of rows) {
+    const [lo, hi] = sliderRange(value, { angle, positive });
+    const row = document.createElement("div");
+    row.className = "control";
+    row.innerHTML = `<label for="n-${name}"><span class="name"></span> <span class="unit"></span></label>
+      <input id="s-${name}" type="range" aria-label="${name} slider">
+      <input id="n-${name}" type="number" step="any">`;
+    row.querySelector(".name").textContent = name;
+    row.querySelector(".unit").textContent = unit || "";
+    const slider = row.querySelector('input[type="range"]');
+    const number = row.querySelector('input[type="number"]');
+    Object.assign(slider, { min: lo, max: hi, step: (hi - lo) / 500 });
+    slider.value = value;
+    number.value = value;
+    slider.addEventListener("input", () => {
+      number.value = slider.value;
+      onChange(name, Number(slider.value));
+    });
+    number.addEventListener("change", () => {
+      const v = Number(number.value);
+      if (number.value === "" || !Number.isFinite(v)) return;
+      if (v < Number(slider.min)) slider.min = v;
+      if (v > Number(slider.max)) slider.max = v;
+      slider.value = v;
+      onChange(name, v);
+    });
+    box.append(row);
+  }
+}
+
+/** Show a value in a control without firing its change (a button set it). */
+export function setControl(name, value) {
+  const slider = document.getElementById(`s-${name}`);
+  const number = document.getElementById(`n-${name}`);
+  if (number) number.value = value;
+  if (slider) {
+    if (value < Number(slider.min)) slider.min = value;
+    if (value > Number(slider.max)) slider.max = value;
+    slider.value = value;
+  }
+}

@@ -1,0 +1,108 @@
+// The derivation, step by step: each step's title, its sentence, its equations (LaTeX rendered by
+// MathJax) with buttons to copy a line as LaTeX or as plain text, and "your turn" boxes that check
+// an answer typed in plain notation (POST /api/v1/check).
+import { postJSON, typeset } from "./api.js";
+
+const el = (tag, props = {}, ...children) => {
+  const node = Object.assign(document.createElement(tag), props);
+  node.append(...children);
+  return node;
+};
+
+/** Inline `$x$` in the engine's sentences becomes MathJax's `\(x\)`. */
+const inlineMath = (text) => text.replace(/\$([^$]+)\$/g, "\\($1\\)");
+
+export function renderSteps(list, derivation, { target, coordinates }) {
+  list.replaceChildren(...derivation.steps.map((step, k) => renderStep(step, k, target, coordinates)));
+}
+
+function renderStep(step, k, target, coordinates) {
+  const li = el("li", { className: "step" });
+  li.dataset.step = step.id;
+  li.append(el("h3", {}, el("span", { className: "num", textContent: `${k + 1}` }), step.title));
+  const body = el("div", { className: "step-body" });
+  const words = el("div", { className: "step-words" });
+  words.append(el("p", { className: "text", textContent: inlineMath(step.text) }));
+  if (step.id === "fbd") {
+    const figure = el("figure", { className: "fbd" });
+    figure.innerHTML = `<svg id="fbd-svg" role="img" aria-label="free-body diagram"></svg>
+      <figcaption><span id="fbd-legend" class="legend"></span>
+      <span class="muted">Drawn at the animation's current instant: pause or scrub to study one.</span></figcaption>`;
+    body.append(figure);
+    for (const note of step.data?.constraints || []) words.append(el("p", { className: "note", textContent: inlineMath(note) }));
+  }
+  step.latex.forEach((tex, j) => words.append(mathLine(tex, step.plain[j] ?? "", step.labels?.[j] ?? "")));
+  body.prepend(words);
+  li.append(body);
+  for (const box of yourTurn(step.id, target, coordinates)) li.append(box);
+  return li;
+}
+
+function mathLine(tex, plain, label) {
+  const row = el("div", { className: "math-line" });
+  const math = el("div", { className: "math", textContent: `\\[${tex}\\]` });
+  math.dataset.latex = tex;
+  const tools = el("div", { className: "line-tools" });
+  if (label) tools.append(el("span", { className: "line-label", textContent: label }));
+  tools.append(copyButton("LaTeX", tex), copyButton("text", plain));
+  row.append(math, tools);
+  return row;
+}
+
+function copyButton(what, text) {
+  const b = el("button", { type: "button", className: "copy", textContent: `copy ${what}`, title: text });
+  b.dataset.copy = what;
+  b.addEventListener("click", async () => {
+    try {
+      await navigator.clipboard.writeText(text);
+      b.textContent = "copied ✓";
+    } catch {
+      window.prompt(`Copy the ${what}:`, text); // no clipboard (plain http on another host)
+    }
+    setTimeout(() => { b.textContent = `copy ${what}`; }, 1200);
+  });
+  return b;
+}
+
+function yourTurn(stepId, target, coordinates) {
+  const asks = {
+    energy: [["T", null, "T ="], ["V", null, "V ="]],
+    forces: coordinates.map((q) => ["Q", q, `Q_${q} =`]),
+    lagrange: [["L", null, "L ="], ...coordinates.map((q) => ["eom", q, `equation of motion for ${q}:`])],
+    matrix: coordinates.length <= 3 ? coordinates.map((q) => ["accel", q, `${q}_ddot =`]) : [],
+  }[stepId] || [];
+  return asks.map(([quantity, coordinate, prompt]) => {
+    const box = el("details", { className: "yourturn" });
+    box.innerHTML = `<summary>Your turn: ${prompt.replace(/\s*[:=]$/, "")}</summary>
+      <div class="row"><span class="prompt"></span><input type="text" placeholder="e.g. 1/2 m l^2 theta'^2"
+      aria-label="your answer"><button type="button" class="check">Check</button>
+      <button type="button" class="reveal">Show answer</button></div>
+      <div class="echo"></div><p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div>`;
+    box.querySelector(".prompt").textContent = prompt;
+    const input = box.querySelector("input");
+    const ask = async (reveal) => {
+      const body = { ...target(), quantity, answer: input.value || "0", reveal };
+      if (coordinate) body.coordinate = coordinate;
+      const verdict = box.querySelector(".verdict");
+      try {
+        const r = await postJSON("/api/v1/check", body);
+        box.querySelector(".echo").textContent = `read as \\(${r.answer_latex}\\)`;
+        verdict.textContent = r.correct ? "✔ Correct" : "✘ Not yet";
+        verdict.className = `verdict ${r.correct ? "ok" : "bad"}`;
+        box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: f })));
+        box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
+        await typeset([box]);
+      } catch (err) {
+        verdict.textContent = err.message;
+        verdict.className = "verdict bad";
+      }
+    };
+    box.querySelector(".check").addEventListener("click", () => ask(false));
+    box.querySelector(".reveal").addEventListener("click", () => ask(true));
+    input.addEventListener("keydown", (e) => {
+      e.stopPropagation(); // typing is not a lecture-mode shortcut
+      if (e.key === "Enter") ask(false);
+    });
+    return box;
+  });
+}

@@ -1,0 +1,44 @@
+// Equilibria of the scene at the current parameters (POST /api/v1/equilibria): where, whether
+// stable, the small-oscillation frequencies, and buttons that start the motion near one.
+import { postJSON } from "./api.js";
+import { fmt } from "./integrator.js";
+
+/** Fill `box`; `startAt(q, mode)` is called by the buttons (mode: a normal-mode shape or null). */
+export async function showEquilibria(box, target, parameters, startAt) {
+  try {
+    const r = await postJSON("/api/v1/equilibria", { ...target, parameters });
+    if (!r.equilibria.length) {
+      box.replaceChildren(Object.assign(document.createElement("p"), {
+        className: "muted", textContent: r.warnings[0] || "No equilibrium at these parameters.",
+      }));
+      return;
+    }
+    const ul = document.createElement("ul");
+    for (const e of r.equilibria) {
+      const li = document.createElement("li");
+      const where = Object.entries(e.q).map(([k, v]) => `${k} = ${fmt(v)}`).join(", ");
+      const closed = Object.entries(e.symbolic).map(([k, v]) => `${k} = ${v}`).join(", ");
+      li.innerHTML = `<div><span class="where"></span> <span class="tag ${e.stable ? "stable" : "unstable"}">${e.stable ? "stable" : "unstable"}</span></div>
+        <div class="muted closed"></div><div class="muted freq"></div><div class="buttons"></div>`;
+      li.querySelector(".where").textContent = where;
+      const exists = e.exists_when && e.exists_when !== "always" ? ` (exists when ${e.exists_when})` : "";
+      li.querySelector(".closed").textContent = closed && closed !== where ? closed + exists : exists;
+      if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.join(", ")}`;
+      if (e.frequencies.length) {
+        li.querySelector(".freq").textContent = `ω = ${e.frequencies.map((f) => fmt(f)).join(", ")} rad/s`;
+      }
+      const buttons = li.querySelector(".buttons");
+      const button = (text, mode) => {
+        const b = Object.assign(document.createElement("button"), { type: "button", textContent: text });
+        b.addEventListener("click", () => startAt(e.q, mode));
+        buttons.append(b);
+      };
+      button("start near", null);
+      e.modes.forEach((mode, k) => button(`excite mode ${k + 1}`, mode));
+      ul.append(li);
+    }
+    box.replaceChildren(ul);
+  } catch (err) {
+    box.replaceChildren(Object.assign(document.createElement("p"), { className: "muted", textContent: err.message }));
+  }
+}

@@ -1,0 +1,114 @@
+// The integrator panel: which method, its tolerance or its step, how long to run, an optional second
+// method to compare; and after each run what it cost and how accurate it was (the `stats`).
+
+export const METHODS = [
+  ["DOP853", "DOP853 — adaptive, order 8"], ["dop853_fortran", "DOP853 (Fortran) — adaptive, order 8"],
+  ["RK45", "RK45 — adaptive, order 5"], ["Radau", "Radau — implicit, stiff"],
+  ["BDF", "BDF — implicit, stiff"], ["LSODA", "LSODA — switches when stiff"],
+  ["rk4", "RK4 — fixed step, order 4"], ["euler", "Euler — fixed step, order 1"],
+  ["symplectic_euler", "symplectic Euler — fixed step"], ["implicit_midpoint", "implicit midpoint — fixed step"],
+];
+const FIXED = new Set(["rk4", "euler", "symplectic_euler", "implicit_midpoint"]);
+export const isFixed = (method) => FIXED.has(method);
+
+const $ = (id) => document.getElementById(id);
+
+/** Give a select the value, adding it as an option first if a shared link brought a new one. */
+function choose(select, value) {
+  if (![...select.options].some((o) => o.value === value)) select.add(new Option(value, value));
+  select.value = value;
+}
+
+export function readSettings(query) {
+  return {
+    method: query.get("method") || "DOP853",
+    methodB: query.get("method_b") || "rk4",
+    tol: query.get("tol") || "1e-9",
+    dt: query.get("dt") || "0.01",
+    t_end: Math.min(120, Math.max(0.1, Number(query.get("t_end")) || 10)),
+    compare: query.get("compare") === "1",
+  };
+}
+
+/** Wire the panel to `settings` (changed in place); `onChange()` after every user change. */
+export function mountIntegrator(settings, onChange) {
+  for (const id of ["method", "method-b"]) {
+    $(id).replaceChildren(...METHODS.map(([v, label]) => new Option(label, v)));
+  }
+  choose($("method"), settings.method);
+  choose($("method-b"), settings.methodB);
+  choose($("tol"), settings.tol);
+  choose($("dt"), settings.dt);
+  $("t_end").value = settings.t_end;
+  $("compare").checked = settings.compare;
+  const sync = () => {
+    settings.method = $("method").value;
+    settings.methodB = $("method-b").value;
+    settings.tol = $("tol").value;
+    settings.dt = $("dt").value;
+    settings.t_end = Math.min(120, Math.max(0.1, Number($("t_end").value) || 10));
+    settings.compare = $("compare").checked;
+    const both = settings.compare ? [settings.method, settings.methodB] : [settings.method];
+    $("dt-box").hidden = !both.some(isFixed);
+    $("tol-box").hidden = both.every(isFixed);
+    $("method-b").disabled = !settings.compare;
+    $("view-b").hidden = !settings.compare;
+    document.querySelector(".stage-views").classList.toggle("two", settings.compare);
+  };
+  sync();
+  for (const id of ["method", "method-b", "tol", "dt", "t_end", "compare"]) {
+    $(id).addEventListener("change", () => { sync(); onChange(); });
+  }
+}
+
+export function fmt(x, digits = 4) {
+  if (x === null || x === undefined || Number.isNaN(x)) return "–";
+  const a = Math.abs(x);
+  if (a !== 0 && (a < 1e-3 || a >= 1e5)) return x.toExponential(2);
+  return Number(x.toPrecision(digits)).toString();
+}
+
+function accuracy(st) {
+  if (st.energy_error !== null && st.energy_error !== undefined) return ["energy error |ΔE| / max T", st.energy_error];
+  if (st.jacobi_error !== null && st.jacobi_error !== undefined) return ["Jacobi-integral error", st.jacobi_error];
+  return ["energy-balance error |ΔE − W_NC| / max T", st.energy_balance_error];
+}
+
+/** The cost and accuracy readout: one column per run. */
+export function showStats(runs) {
+  const table = $("stats");
+  const rows = [
+    ["method", (r) => r.stats.method],
+    ["wall time", (r) => `${fmt(r.stats.wall_time * 1e3, 3)} ms`],
+    ["steps", (r) => r.stats.steps.toLocaleString("en")],
+    ["RHS evaluations", (r) => r.stats.rhs_evaluations.toLocaleString("en")],
+    [accuracy(runs[0].stats)[0], (r) => fmt(accuracy(r.stats)[1], 2)],
+  ];
+  for (const k of Object.keys(runs[0].stats.momentum_drift || {})) {
+    rows.push([`p_${k} drift`, (r) => fmt((r.stats.momentum_drift || {})[k], 2)]);
+  }
+  rows.push(["status", (r) => r.stats.status]);
+  const head = runs.length > 1 ? `<tr><th></th><th>A</th><th>B</th></tr>` : "";
+  table.innerHTML = `<thead>${head}</thead><tbody></tbody>`;
+  const body = table.querySelector("tbody");
+  for (const [label, get] of rows) {
+    const tr = document.createElement("tr");
+    const th = document.createElement("th");
+    th.textContent = label;
+    tr.append(th);
+    for (const r of runs) {
+      const td = document.createElement("td");
+      td.textContent = String(get(r));
+      if (label === "status" && r.stats.status !== "ok") td.className = "bad";
+      tr.append(td);
+    }
+    body.append(tr);
+  }
+  table.dataset.wallTime = String(runs[0].stats.wall_time);
+  const warnings = runs.flatMap((r, k) => r.warnings.map((w) => (runs.length > 1 ? `${"AB"[k]}: ${w}` : w)));
+  showWarnings(warnings);
+}
+
+export function showWarnings(list) {
+  $("warnings").replaceChildren(...list.map((w) => Object.assign(document.createElement("li"), { textContent: w })));
+}
