@@ -239,6 +239,7 @@ def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) ->
         if run.nsteps >= max_steps:
             raise _Stop(f"step budget ({max_steps}) exhausted at t = {solver.t:.6g} s")
         f.bad_t = None
+        t_before = solver.t
         try:
             message = solver.step()
         except (ValueError, np.linalg.LinAlgError):  # e.g. the LU of a NaN Jacobian
@@ -246,6 +247,10 @@ def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) ->
                 raise
             solver.status = "failed"
         run.njev = solver.njev
+        if solver.t == t_before and solver.status == "running":
+            # LSODA at a blow-up reports "running" steps of size 0 (t stuck, y drifting) until a
+            # budget runs out: no progress is a failure, blamed on a non-finite RHS if there was one
+            solver.status, message = "failed", "the step size fell to zero"
         if solver.status == "failed":
             if f.bad_t is not None:  # blame the cause, not the symptom ("step too small")
                 raise _Stop(f"the right-hand side became non-finite at t = {f.bad_t:.6g} s")
