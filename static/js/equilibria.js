@@ -1,10 +1,31 @@
 // Equilibria of the scene at the current parameters (POST /api/v1/equilibria): where, whether
 // stable, the small-oscillation frequencies, and buttons that start the motion near one.
 import { postJSON } from "./api.js";
+import { SceneGeometry } from "./geometry.js";
 import { fmt } from "./integrator.js";
+import { toSVG } from "./render.js";
+import { sceneShapes } from "./shapes.js";
+import { View } from "./view.js";
+
+const W = 150, H = 100;
+
+/** A small drawing of the system resting at q (one zero-length run gives the positions). */
+async function sketch(svg, target, parameters, spec, q) {
+  try {
+    const initial = Object.fromEntries(Object.entries(q).flatMap(([k, v]) => [[k, v], [`${k}_dot`, 0]]));
+    const run = await postJSON("/api/v1/simulate", { ...target, parameters, initial, t_end: 0,
+      check_sensitivity: false });
+    const geom = new SceneGeometry(spec, run);
+    const view = new View(W, H, geom.is3D).fit(geom.extent(), geom.is3D ? 8 : 14);
+    svg.innerHTML = toSVG(sceneShapes(geom, view, 0, { radius: 6, path: false, axes: false }));
+    svg.dataset.ready = "1";
+  } catch {
+    svg.remove();
+  }
+}
 
 /** Fill `box`; `startAt(q, mode)` is called by the buttons (mode: a normal-mode shape or null). */
-export async function showEquilibria(box, target, parameters, startAt) {
+export async function showEquilibria(box, target, parameters, startAt, spec = null) {
   try {
     const r = await postJSON("/api/v1/equilibria", { ...target, parameters });
     if (!r.equilibria.length) {
@@ -21,6 +42,15 @@ export async function showEquilibria(box, target, parameters, startAt) {
       li.innerHTML = `<div><span class="where"></span> <span class="tag ${e.stable ? "stable" : "unstable"}">${e.stable ? "stable" : "unstable"}</span></div>
         <div class="muted closed"></div><div class="muted freq"></div><div class="buttons"></div>`;
       li.querySelector(".where").textContent = where;
+      if (spec) {
+        const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
+        svg.setAttribute("class", "eq-sketch");
+        svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+        svg.setAttribute("width", W);
+        svg.setAttribute("height", H);
+        li.prepend(svg);
+        sketch(svg, target, parameters, spec, e.q);
+      }
       const exists = e.exists_when && e.exists_when !== "always" ? ` (exists when ${e.exists_when})` : "";
       li.querySelector(".closed").textContent = closed && closed !== where ? closed + exists : exists;
       if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.join(", ")}`;

@@ -10,6 +10,7 @@ import { drawFBD, fbdLegend } from "./fbd.js";
 import { isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
 import { Lecture } from "./lecture.js";
 import { plotRun, plotlyReady } from "./plots.js";
+import { showWork, watchWorkInputs } from "./work.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -48,6 +49,7 @@ class SceneView {
       onToggle: () => { this.#saveURL(); this.#plot(); }, onPlay: () => this.togglePlay(),
     });
     this.lecture.set(query.get("lecture") === "1");
+    watchWorkInputs(() => this.#plot());
     $("phase-q").addEventListener("change", () => { this.phase = $("phase-q").value; this.#saveURL(); this.#plot(); });
     $("reset").addEventListener("click", () => this.#reset());
     this.#loop();
@@ -169,6 +171,7 @@ class SceneView {
     const s = this.settings;
     plotRun({ a: this.result, b: this.resultB, labels: [s.method, s.methodB], spec: this.spec,
       phase: $("phase-q").value, lecture: this.lecture.on });
+    showWork(this.result, { lecture: this.lecture.on });
   }
 
   // ------------------------------------------------------------------ playback
@@ -252,7 +255,7 @@ class SceneView {
   }
 
   async equilibria() {
-    await showEquilibria($("equilibria"), this.target(), this.params, (q, mode) => this.startAt(q, mode));
+    await showEquilibria($("equilibria"), this.target(), this.params, (q, mode) => this.startAt(q, mode), this.spec);
   }
 
   startAt(q0, mode) {

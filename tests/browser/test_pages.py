@@ -255,3 +255,34 @@ def test_unknown_scene_page_is_a_404(server, page):
     response = page.page.goto(f"{server}/scenes/no_such_scene")
     assert response.status == 404
     assert "no_such_scene" in page.page.inner_text("main")
+
+
+def test_work_energy_table_balances_and_constraint_forces_are_plotted(server, page, artifacts):
+    """Damped, driven oscillator: W^NC of damper and drive equals ΔT + ΔV between two times."""
+    p = page.page
+    p.goto(f"{server}/scenes/spring_mass_damper")
+    wait_ready(page)
+    p.wait_for_function("document.querySelector('#work-table').dataset.gap !== undefined")
+    table = p.inner_text("#work-table")
+    assert "damper" in table and "force drive" in table and "balanced" in table
+    assert abs(float(p.get_attribute("#work-table", "data-gap"))) < 1e-5
+    p.fill("#work-t1", "2")
+    p.dispatch_event("#work-t1", "change")
+    p.wait_for_function("document.querySelector('#work-table').textContent.includes('balanced')")
+    assert p.locator("#plot-work .main-svg").count() > 0
+    assert p.locator("#plot-constraint .main-svg").count() > 0
+    p.locator("#work-panel").screenshot(path=str(artifacts / "work-energy.png"))
+    assert page.errors == []
+
+
+def test_equilibria_are_listed_and_drawn(server, page):
+    p = page.page
+    p.goto(f"{server}/scenes/bead_on_hoop")
+    wait_ready(page)
+    p.wait_for_function(
+        "[...document.querySelectorAll('#equilibria svg.eq-sketch')].length === 4"
+        " && [...document.querySelectorAll('#equilibria svg.eq-sketch')]"
+        ".every(s => s.dataset.ready === '1')"
+    )
+    assert "acos" in p.inner_text("#equilibria")
+    assert page.errors == []

@@ -1,0 +1,73 @@
+// Work and energy between two times (notes II.B, III): each force's W_1→2, ΔT, ΔV and the check
+// W^NC = ΔT + ΔV, as a table and a stacked plot; and the constraint forces along the run — the
+// result Newton's method gives and Lagrange's hides (a pendulum's tension, where a string would
+// go slack).
+
+const $ = (id) => document.getElementById(id);
+const CONFIG = { responsive: true, displaylogo: false };
+
+function fmt(x) {
+  const a = Math.abs(x);
+  return a !== 0 && (a < 1e-3 || a >= 1e5) ? x.toExponential(3) : x.toFixed(4);
+}
+
+function label(key) {
+  const [kind, rest] = key.split(":");
+  const name = rest.split("@")[0];
+  return { weight: `weight of ${name}`, spring: `spring ${name}`, potential: `potential ${name}`,
+    damper: `damper ${name}`, force: `force ${name}`, torque: `torque ${name}` }[kind] || key;
+}
+
+function index(t, time) {
+  let i = 0;
+  while (i < t.length - 1 && t[i + 1] <= time + 1e-12) i += 1;
+  return i;
+}
+
+export function showWork(run, { lecture = false } = {}) {
+  if (!run || !run.work) return;
+  const t = run.t, end = t[t.length - 1];
+  const t1box = $("work-t1"), t2box = $("work-t2");
+  if (t2box.value === "" || Number(t2box.value) > end) t2box.value = end.toFixed(2);
+  const i = index(t, Math.max(0, Number(t1box.value) || 0));
+  const j = index(t, Math.min(end, Number(t2box.value)));
+  const rows = [];
+  let wc = 0, wnc = 0;
+  for (const [k, w] of Object.entries(run.work.conservative)) { rows.push([label(k), w[j] - w[i], "conservative"]); wc += w[j] - w[i]; }
+  for (const [k, w] of Object.entries(run.work.non_conservative)) { rows.push([label(k), w[j] - w[i], "non-conservative"]); wnc += w[j] - w[i]; }
+  const e = run.energy;
+  const dT = e.T[j] - e.T[i], dV = e.V[j] - e.V[i];
+  const html = [`<tr><th>force</th><th>kind</th><th>W<sub>1→2</sub> (J)</th></tr>`];
+  for (const [name, w, kind] of rows) html.push(`<tr><td>${name}</td><td>${kind}</td><td>${fmt(w)}</td></tr>`);
+  html.push(`<tr class="sum"><td>ΔT</td><td></td><td>${fmt(dT)}</td></tr>`);
+  html.push(`<tr class="sum"><td>ΔV = −W<sup>C</sup></td><td></td><td>${fmt(dV)}</td></tr>`);
+  html.push(`<tr class="sum"><td>W<sup>NC</sup></td><td></td><td>${fmt(wnc)}</td></tr>`);
+  const gap = wnc - (dT + dV);
+  const scale = Math.max(Math.abs(dT), Math.abs(dV), Math.abs(wnc), 1e-300);
+  html.push(`<tr class="check"><td>W<sup>NC</sup> − (ΔT + ΔV)</td><td>${Math.abs(gap) <= 1e-5 * scale ? "✔ balanced" : "✘"}</td><td>${fmt(gap)}</td></tr>`);
+  $("work-table").innerHTML = html.join("");
+  $("work-table").dataset.gap = String(gap / scale);
+  if (typeof window.Plotly === "undefined") return;
+  const ink = lecture ? "#f1f3f5" : "#1d2430";
+  const base = { margin: { l: 60, r: 12, t: 40, b: 46 }, paper_bgcolor: "rgba(0,0,0,0)",
+    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 16 : 12 },
+    legend: { orientation: "h", y: -0.3 } };
+  const span = t.slice(i, j + 1);
+  const traces = Object.entries(run.work.non_conservative).map(([k, w]) => ({
+    x: span, y: w.slice(i, j + 1).map((v) => v - w[i]), name: `W ${label(k)}`, stackgroup: "nc", mode: "none" }));
+  traces.push({ x: span, y: span.map((_, k) => e.T[i + k] - e.T[i] + e.V[i + k] - e.V[i]), name: "ΔT + ΔV",
+    mode: "lines", line: { color: ink, width: 2, dash: "dot" } });
+  window.Plotly.react("plot-work", traces, { ...base, title: { text: "W of each non-conservative force (stacked) and ΔT + ΔV" },
+    xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "J" } } }, CONFIG);
+  const forces = run.constraint_forces || {};
+  const ctraces = Object.entries(forces).map(([body, f]) => f.tension
+    ? { x: t, y: f.tension, name: `tension on ${body}`, mode: "lines" }
+    : { x: t, y: f.x.map((x, k) => Math.hypot(x, f.y[k], f.z[k])), name: `|R| on ${body}`, mode: "lines" });
+  window.Plotly.react("plot-constraint", ctraces, { ...base,
+    title: { text: "constraint forces along the run — a negative tension means a string would go slack" },
+    xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
+}
+
+export function watchWorkInputs(onChange) {
+  for (const id of ["work-t1", "work-t2"]) $(id).addEventListener("change", onChange);
+}
