@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import logging
 import os
+from collections.abc import Callable
 from typing import Any
+
+from fastapi import HTTPException
 
 from app.schemas import DeriveResponse
 from mechanics.budget import run_with_budget
@@ -72,3 +75,24 @@ def posted_json(scene: SceneSpec) -> bytes:
 def _encode(result: dict[str, Any]) -> bytes:
     """Validate against the documented response once, when computed, and keep its JSON."""
     return DeriveResponse.model_validate(result).model_dump_json().encode()
+
+
+def on_scene(request: Any, work: Callable[..., Any], *args: Any) -> Any:
+    """``work(derivation, *args)`` for the scene a request names, the one way every analysis route
+    reaches the engine: a built-in scene in this process (its derivation is cached), a posted one
+    in a child process under the time and memory budget."""
+    if request.scene_id is not None:
+        if request.scene_id not in scene_ids():
+            raise HTTPException(status_code=404, detail=f"unknown scene '{request.scene_id}'")
+        from mechanics.derive import derivation_of_scene
+
+        return work(derivation_of_scene(request.scene_id), *args)
+    document = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    parse_spec(document)
+    return run_with_budget(_derive_then, document, work, *args, seconds=derive_seconds())
+
+
+def _derive_then(document: dict, work: Callable[..., Any], *args: Any) -> Any:
+    from mechanics.derive import derive_model
+
+    return work(derive_model(document), *args)
