@@ -72,6 +72,8 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
         if potential_force is not None:
             support = _support_force(b, R_nice, m)
             forces.append(ConstraintForce(b.name, frame, R_nice, comps, support))
+            if support is not None and frame == "N":
+                balance_lines += _polar_lines(b, support[0], b.mass * a, applied, m)
         if b.frame is not None:  # Σ M_G = dH_G/dt (eq. 11); the constraint moment is the rest
             omega = b.frame.ang_vel_in(m.N)
             dH = b.inertia.dot(omega).dt(m.N)
@@ -117,6 +119,30 @@ def _support_force(b: Any, R: Vector, m: Any) -> tuple[str, sp.Expr] | None:
         return None
     tension = tidy(-R.dot(rel) / sp.sqrt(length2), m)
     return anchor, tension
+
+
+def _polar_lines(b: Any, anchor: str, ma: Vector, applied: Vector, m: Any) -> list[Line]:
+    """A pendulum declared in x, y, balanced as the notes do: along ê_r (to the bob) and ê_θ.
+
+    Along the rod the tension T enters (m a·ê_r = ΣF·ê_r − T); across it nothing does.
+    """
+    rel = b.position - m.positions[anchor]
+    if tidy(rel.dot(m.N.z), m) != 0:
+        return []  # not planar: the spherical basis of the scene's own frames is used instead
+    e_r = rel / sp.sqrt(tidy(rel.dot(rel), m))
+    e_t = m.N.z.cross(e_r)
+    name = sub(b.name)
+    lines = []
+    for label, e, extra in (("r", e_r, " - T"), (r"\theta", e_t, "")):
+        lhs, rhs = tidy(ma.dot(e), m), tidy(applied.dot(e), m)
+        lines.append(
+            Line(
+                f"{'radial' if label == 'r' else 'tangential'} balance of {b.name}",
+                rf"m a_{{{label}}} = {to_latex(lhs)} = {to_latex(rhs)}{extra}\quad({name})",
+                f"m a_{label.strip(chr(92))} = {to_plain(lhs)} = {to_plain(rhs)}{extra}",
+            )
+        )
+    return lines
 
 
 def _components(v: Vector, frame) -> list[tuple[sp.Expr, Vector]]:

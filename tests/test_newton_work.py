@@ -47,6 +47,13 @@ def test_pendulum_tension_is_m_g_cos_theta_plus_m_l_theta_dot_squared():
     assert sp.simplify(bob.support[1] - m * (g * sp.cos(theta) + length * theta_dot**2)) == 0
 
 
+def test_pendulum_balance_is_written_in_polar_components_as_the_notes_do():
+    steps, _, _ = newton(derivation_of_scene("simple_pendulum"))
+    plain = steps[0].to_json()["plain"]
+    assert "m a_theta = l*m*theta_ddot = -g*m*sin(theta)" in plain
+    assert "m a_r = -l*m*theta_dot**2 = g*m*cos(theta) - T" in plain
+
+
 def test_atwood_string_tension():
     r = client.post("/api/v1/newton", json={"scene_id": "atwood_machine"}).json()
     assert r["agrees_with_lagrange"]
