@@ -276,13 +276,15 @@ def test_a_real_server_is_fast_warm_and_survives_bad_and_runaway_requests(tmp_pa
                 start = time.perf_counter()
                 assert http.post("/api/v1/derive", json=builtin).status_code == 200
                 timings.append(time.perf_counter() - start)
-            assert statistics.median(timings) < 0.005, timings
+            # ~1.5 ms on an idle machine (python -m mechanics.bench derive measures it); the
+            # bound here only proves the warm path is a lookup, not a derivation (~100 ms+)
+            assert statistics.median(timings) < 0.05, timings
             for _ in range(3):
                 start = time.perf_counter()
                 assert http.post("/api/v1/derive", json={"scene": PENDULUM}).status_code == 503
                 # SIGTERM ends the child at once (uvicorn's own handler would only ask it to):
                 # no waiting out the grace period before SIGKILL.
-                assert time.perf_counter() - start < 0.9
+                assert time.perf_counter() - start < 3.0
             assert http.post("/api/v1/derive", json={}).status_code == 422
             bad = scene_with(coordinates=["1x"])
             assert http.post("/api/v1/derive", json={"scene": bad}).status_code == 422

@@ -156,9 +156,10 @@ def test_the_wall_time_budget_stops_a_sleeping_rhs_near_the_budget(method):
     elapsed = time.perf_counter() - start
     assert run.status == "stopped"
     assert "wall-time" in run.message
-    # the clock is checked before every RHS call, so the overshoot is about one call
-    assert budget <= elapsed < budget + 0.25
-    assert run.wall_time == pytest.approx(elapsed, abs=0.05)
+    # the clock is checked before every RHS call, so the overshoot is about one call; the
+    # bound is loose because a busy CI machine stretches any wall clock
+    assert budget <= elapsed < budget + 1.0
+    assert run.wall_time == pytest.approx(elapsed, abs=0.2)
     stopped = float(re.search(r"t = ([-+0-9.e]+)", run.message).group(1))
     assert 0 <= stopped < 50
     # what it has is a prefix of the requested samples, and right

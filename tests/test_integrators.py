@@ -209,7 +209,7 @@ def test_the_wall_time_budget_stops_a_slow_run(method):
     )
     elapsed = time.perf_counter() - start
     assert run.status == "stopped" and "wall-time budget" in run.message
-    assert 0.2 <= elapsed < 0.5 and run.wall_time == pytest.approx(elapsed, abs=0.05)
+    assert 0.2 <= elapsed < 1.2 and run.wall_time == pytest.approx(elapsed, abs=0.2)
     assert len(run.t) < 101 and len(run.y) == len(run.t)
 
 
