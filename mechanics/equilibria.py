@@ -53,10 +53,11 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             "sympy could not solve the conditions in closed form: the equilibria "
             "below were found numerically."
         )
-    results = []
+    results, linearized = [], []
     for numeric_q, symbolic_q, exists in found:
         q0 = [numeric_q.get(j, 0.0) for j in range(len(m.q))]
-        stable, freqs, modes = _stability(d, q0, len(free), values)
+        stable, freqs, modes, linear = _stability(d, q0, len(free), values)
+        linearized.append(linear)
         results.append(
             {
                 "q": {m.coordinate_names[j]: q0[j] for j in range(len(m.q))},
@@ -68,13 +69,11 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 "modes": modes,
             }
         )
-    results.sort(key=lambda r: [abs(v) for v in r["q"].values()])
-    steps.append(_stability_step(d, results))
+    order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
+    results, linearized = [results[i] for i in order], [linearized[i] for i in order]
+    steps.append(_stability_step(d, results, linearized))
     if not results:
-        warnings.append(
-            "No equilibrium: the forces at rest never balance (e.g. a central "
-            "force with nothing to hold the body off the centre)."
-        )
+        warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
 
 
@@ -257,7 +256,7 @@ def _stability(d, q0, n_free, values):
     C = np.array([[-num(fj.diff(m.qd[k])) for k in idx] for fj in f])
     M = full_M[np.ix_(idx, idx)]
     if not idx:
-        return True, [], []
+        return True, [], [], None
     A = np.block(
         [[np.zeros_like(M), np.eye(len(idx))], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]]
     )
@@ -276,18 +275,42 @@ def _stability(d, q0, n_free, values):
                 mode[j] = float(x)
             freqs.append(float(math.sqrt(w2[i])))
             modes.append(mode)
-    return stable, freqs, modes
+    linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
+    return stable, freqs, modes, linear
 
 
-def _stability_step(d: Derivation, results: list[dict]) -> Step:
+def _matrix(a: np.ndarray) -> str:
+    return to_latex(sp.Matrix(a.shape[0], a.shape[1], [sp.Float(float(x), 5) for x in a.flat]))
+
+
+def _linear_latex(linear: dict) -> str:
+    """M δq̈ + C δq̇ + K δq = 0 with the numbers at this equilibrium and these parameters."""
+    qs = linear["coordinates"]
+    dq = to_latex(sp.Matrix([sp.Symbol(rf"\delta {to_latex(q)}") for q in qs]))
+    dqd = to_latex(sp.Matrix([sp.Symbol(rf"\delta \dot{{{to_latex(q)}}}") for q in qs]))
+    dqdd = to_latex(sp.Matrix([sp.Symbol(rf"\delta \ddot{{{to_latex(q)}}}") for q in qs]))
+    damping = "" if not np.any(linear["C"]) else f" + {_matrix(linear['C'])}{dqd}"
+    return f"{_matrix(linear['M'])}{dqdd}{damping} + {_matrix(linear['K'])}{dq} = 0"
+
+
+def _stability_step(d: Derivation, results: list[dict], linearized: list) -> Step:
     text = (
         "About each equilibrium q₀ the motion linearizes to M δq̈ + C δq̇ + K δq = 0 with "
         "K = −∂f/∂q and C = −∂f/∂q̇ at rest. It is stable when no mode grows; then "
         "K v = ω² M v gives the small-oscillation frequencies and normal modes."
     )
     lines = []
-    for r in results:
+    for r, linear in zip(results, linearized, strict=True):
         q = ", ".join(f"{k} = {v:.4g}" for k, v in r["q"].items())
+        if linear is not None:
+            lines.append(
+                Line(
+                    f"linearized about {q}",
+                    _linear_latex(linear),
+                    f"M = {linear['M'].tolist()}, C = {linear['C'].tolist()}, "
+                    f"K = {linear['K'].tolist()}",
+                )
+            )
         verdict = "stable" if r["stable"] else "unstable"
         freqs = ", ".join(f"{f:.4g}" for f in r["frequencies"])
         lines.append(

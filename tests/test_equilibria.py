@@ -93,3 +93,13 @@ def test_bad_parameters_are_422():
         "/api/v1/equilibria", json={"scene_id": "simple_pendulum", "parameters": {"nope": 1}}
     )
     assert r.status_code == 422
+
+
+def test_the_linearized_equations_are_shown_with_their_matrices():
+    """Coupled oscillators: M = m I, K = [[k + k12, −k12], [−k12, k + k12]], no damping."""
+    k, k12, m = 4.0, 1.5, 0.5
+    r = post(scene_id="coupled_oscillators", parameters={"k": k, "k12": k12, "m": m})
+    (line,) = [p for p in r["steps"][1]["plain"] if p.startswith("M = ")]
+    assert f"M = {[[m, 0.0], [0.0, m]]}" in line
+    assert f"K = {[[k + k12, -k12], [-k12, k + k12]]}" in line
+    assert r"\delta \ddot" in r["steps"][1]["latex"][0]
