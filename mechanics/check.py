@@ -57,15 +57,9 @@ def expected_quantity(d: Derivation, quantity: str, j: int | None) -> sp.Expr:
         "L": lambda: w.L,
         "Q": lambda: w.Q[j],
         "eom": lambda: w.eom_lhs[j] - w.Q[j],
-        "accel": lambda: _acceleration(d, j),
+        "accel": lambda: d.solved_accelerations[j],
         "momentum": lambda: w.momenta[j],
     }[quantity]()
-
-
-def _acceleration(d: Derivation, j: int) -> sp.Expr:
-    if d.work.accelerations is not None:
-        return d.work.accelerations[j]
-    return d.work.mass_matrix.LUsolve(d.work.forcing)[j]
 
 
 def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = None) -> Verdict:
@@ -104,7 +98,7 @@ def _latex(d: Derivation, quantity: str, j: int | None) -> str:
     if quantity == "eom":
         return f"{to_latex(w.eom_lhs[j])} = {to_latex(w.Q[j])}"
     if quantity == "accel":
-        return f"{to_latex(m.qdd[j])} = {to_latex(_acceleration(d, j))}"
+        return f"{to_latex(m.qdd[j])} = {to_latex(d.solved_accelerations[j])}"
     return to_latex(expected_quantity(d, quantity, j))
 
 
@@ -200,7 +194,7 @@ class _Judge:
                 "equation (the same equation, rearranged or scaled)."
             )
             return
-        solved = dict(zip(self.m.qdd, self._accelerations(), strict=True))
+        solved = dict(zip(self.m.qdd, self.d.solved_accelerations, strict=True))
         if self.same(given.xreplace(solved), sp.S.Zero):
             fb.append(
                 "Your equation holds along the motion, but it is not the equation for "
@@ -209,12 +203,6 @@ class _Judge:
             )
             return
         self._diagnose(given, expected, fb)
-
-    def _accelerations(self) -> list[sp.Expr]:
-        d = self.d
-        if d.work.accelerations is not None:
-            return d.work.accelerations
-        return list(d.work.mass_matrix.LUsolve(d.work.forcing))
 
     # -- what is wrong ---------------------------------------------------------------------
     def _diagnose(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:

@@ -52,6 +52,15 @@ class Derivation:
     steps: list[Step]
     seconds: float
 
+    @functools.cached_property
+    def solved_accelerations(self) -> list[Any]:
+        """q̈: the simplified symbolic solution where the derivation has one, else M⁻¹f
+        (n > 3, or the time budget ran out). Checking answers and Newton's method both need it."""
+        w = self.work
+        if w.accelerations is not None:
+            return list(w.accelerations)
+        return list(w.mass_matrix.LUsolve(w.forcing))
+
     def equations(self, fmt: Any) -> dict[str, Any]:
         """The results in one format (to_plain or to_latex), keyed as the API documents."""
         m, w = self.model, self.work

@@ -35,7 +35,7 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
     """Steps, the constraint force on every particle, and the equations Newton's method gives."""
     m = d.model
     acting = body_forces(m)
-    solved = dict(zip(m.qdd, _accelerations(d), strict=True))
+    solved = dict(zip(m.qdd, d.solved_accelerations, strict=True))
     balance_lines: list[Line] = []
     forces: list[ConstraintForce] = []
     residual = [sp.S.Zero] * len(m.q)  # Σ_i (m a_i − F_i)·∂r_i/∂q_j, torques included
@@ -147,12 +147,6 @@ def _polar_lines(b: Any, anchor: str, ma: Vector, applied: Vector, m: Any) -> li
 
 def _components(v: Vector, frame) -> list[tuple[sp.Expr, Vector]]:
     return [(v.dot(u), u) for u in (frame.x, frame.y, frame.z)]
-
-
-def _accelerations(d: Derivation) -> list[sp.Expr]:
-    if d.work.accelerations is not None:
-        return d.work.accelerations
-    return list(d.work.mass_matrix.LUsolve(d.work.forcing))
 
 
 def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -> list[Step]:

@@ -9,6 +9,7 @@ where numpy on scalars costs several times that. Everything evaluated along a fi
 from __future__ import annotations
 
 import functools
+import json
 from dataclasses import dataclass
 from typing import Any
 
@@ -194,15 +195,11 @@ def compiled_scene(scene_id: str) -> CompiledScene:
 
 @functools.lru_cache(maxsize=32)
 def _compiled_spec(spec_json: str) -> CompiledScene:
-    import json
-
     return compile_derivation(derive_model(json.loads(spec_json)))
 
 
 def compiled_spec(spec: dict) -> CompiledScene:
     """A posted spec compiled once per distinct spec (keyed by its canonical JSON)."""
-    import json
-
     return _compiled_spec(json.dumps(spec, sort_keys=True))
 
 

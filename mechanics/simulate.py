@@ -49,10 +49,6 @@ class SimulationRequest:
     constraint_forces: bool = False
 
 
-def _fail(field_: str, message: str) -> SpecError:
-    return SpecError([{"field": field_, "message": message}])
-
-
 def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float], np.ndarray]:
     """Bounds and names, each error naming its field; returns parameter values and y0."""
     spec = c.derivation.model.spec

@@ -238,8 +238,3 @@ def eq_line(label: str, lhs_latex: str, expr: sp.Expr, lhs_plain: str | None = N
     return Line(
         label, f"{lhs_latex} = {to_latex(expr)}", f"{lhs_plain or label} = {to_plain(expr)}"
     )
-
-
-def q_latex(model: Any, j: int, order: int = 0) -> str:
-    """LaTeX of q_j, its velocity or acceleration, with the dot notation."""
-    return to_latex([model.q, model.qd, model.qdd][order][j])

@@ -47,13 +47,6 @@ def lagrange_equations(model: Model, work: Work) -> Step:
     return Step("lagrange", "Lagrangian and Euler–Lagrange equations", text, lines)
 
 
-def eom_strings(model: Model, work: Work) -> dict[str, str]:
-    return {
-        name: f"{to_plain(lhs)} = {to_plain(Q)}"
-        for name, lhs, Q in zip(model.coordinate_names, work.eom_lhs, work.Q, strict=True)
-    }
-
-
 def ratio(num: sp.Expr, den: sp.Expr, model: Model) -> sp.Expr:
     """num/den with common polynomial factors cancelled and each side tidied separately."""
     n, d = sp.fraction(sp.cancel(sp.factor_terms(num) / sp.factor_terms(den)))
