@@ -17,6 +17,7 @@ import numpy as np
 import sympy as sp
 from sympy.physics.vector import Vector
 
+from mechanics import native
 from mechanics.derive import Derivation, derivation_of_scene, derive_model
 from mechanics.model import T as t
 from mechanics.steps.energy import potential_parts
@@ -51,10 +52,20 @@ class CompiledScene:
     places: dict[str, Any]  # arrays: -> (x, y, z) of each point/body
     frames: dict[str, Any]  # arrays: -> 9 components of the frame's axes in N
     solved: bool  # True: q̈ from the symbolic solution; False: M q̈ = f solved numerically
+    native_inputs: dict[str, Any]  # rhs_source's arguments: the same expressions, for C
 
     @property
     def n(self) -> int:
         return len(self.coordinates)
+
+    @functools.cached_property
+    def native_source(self) -> str:
+        """The right-hand side as C (generated on first use: most scenes never need it)."""
+        return native.rhs_source(**self.native_inputs)
+
+    def native_rhs(self, params: list[float]) -> native.NativeRhs:
+        """The compiled twin of `rhs(params)`; raises NativeUnavailable when it cannot be built."""
+        return native.compile_rhs(self.native_source, params, 2 * self.n + 1)
 
     def rhs(self, params: list[float]):
         """dy/dt for y = [q, q̇, W_NC]: the work of the non-conservative forces rides along."""
@@ -110,6 +121,12 @@ def compile_derivation(d: Derivation) -> CompiledScene:
 
     power = sum((Q * qd for Q, qd in zip(w.Q, m.qd, strict=True)), sp.S.Zero)
     solved = w.accelerations is not None
+    native_inputs = {"args": args, "n": len(m.q), "power": _plain(power, subs)}
+    if solved:
+        native_inputs["accelerations"] = [_plain(e, subs) for e in w.accelerations]
+    else:
+        native_inputs["mass"] = [_plain(e, subs) for e in w.mass_matrix]
+        native_inputs["forcing"] = [_plain(e, subs) for e in w.forcing]
     if solved:
         accel_and_power = scalar([*w.accelerations, power])
         mass_and_forcing = None
@@ -162,6 +179,7 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         places=places,
         frames=frames,
         solved=solved,
+        native_inputs=native_inputs,
     )
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from scipy.integrate import cumulative_simpson
 
 from mechanics.integrators import METHODS, integrate
+from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
     CompiledScene,
     compiled_scene,
@@ -109,6 +110,12 @@ def _run(
     rtol: float,
     atol: float,
 ):
+    compiled = None
+    if req.method == "dop853_c":
+        try:
+            compiled = c.native_rhs(params)
+        except NativeUnavailable:
+            pass  # the C loop calls the Python right-hand side back (or scipy runs it)
     return integrate(
         c.rhs(params),
         y0,
@@ -119,6 +126,7 @@ def _run(
         dt=req.dt,
         max_wall_time=MAX_WALL_TIME,
         second_order=c.n,
+        native=compiled,
     )
 
 
@@ -127,7 +135,7 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     n_samples = int(math.floor(req.t_end * req.fps + 1e-9)) + 1
     t_eval = np.linspace(0.0, (n_samples - 1) / req.fps, n_samples)
     run = _run(c, params, y0, t_eval, req, req.rtol, req.atol)
-    warnings: list[str] = []
+    warnings: list[str] = [run.note] if run.note else []
     if run.status != "ok":
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
         if "step" in run.message.lower() or "budget" in run.message.lower():
