@@ -110,13 +110,13 @@ def _run(
     rtol: float,
     atol: float,
 ):
-    compiled = None
+    compiled, why = None, ""
     if req.method == "dop853_c":
         try:
             compiled = c.native_rhs(params)
-        except NativeUnavailable:
-            pass  # the C loop calls the Python right-hand side back (or scipy runs it)
-    return integrate(
+        except NativeUnavailable as exc:
+            why = str(exc)  # the C loop calls the Python right-hand side back (or scipy runs it)
+    run = integrate(
         c.rhs(params),
         y0,
         t_eval,
@@ -128,6 +128,9 @@ def _run(
         second_order=c.n,
         native=compiled,
     )
+    if why and not run.note:
+        run.note = f"The equations could not be compiled to C ({why}): the C loop called Python."
+    return run
 
 
 def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any]:
@@ -139,7 +142,7 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     if run.status != "ok":
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
         if "step" in run.message.lower() or "budget" in run.message.lower():
-            if req.method in ("RK45", "DOP853", "euler", "rk4", "symplectic_euler"):
+            if not METHODS[req.method].implicit:
                 warnings.append("This looks stiff for an explicit method: try Radau or BDF.")
     t, y = run.t, run.y
     n = c.n

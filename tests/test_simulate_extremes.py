@@ -148,7 +148,8 @@ def test_a_pendulum_far_from_the_top_carries_no_sensitivity_warning():
 # --- Kepler ---------------------------------------------------------------------------------
 
 
-def test_kepler_orbit_e_0_9_keeps_its_period_and_perihelion():
+@pytest.mark.parametrize("method", ["DOP853", "dop853_c"])
+def test_kepler_orbit_e_0_9_keeps_its_period_and_perihelion(method):
     e, a, gm = 0.9, 1.0, 1.0
     r_p, r_a = a * (1 - e), a * (1 + e)
     theta_dot0 = math.sqrt(gm * (1 + e) / r_p) / r_p
@@ -158,7 +159,7 @@ def test_kepler_orbit_e_0_9_keeps_its_period_and_perihelion():
         initial={"r": r_p, "r_dot": 0.0, "theta": 0.0, "theta_dot": theta_dot0},
         t_end=7,
         fps=60,
-        method="DOP853",
+        method=method,
         rtol=1e-12,
         atol=1e-12,
         check_sensitivity=False,
@@ -190,10 +191,11 @@ def test_kepler_orbit_e_0_9_keeps_its_period_and_perihelion():
 # --- long runs and energy -------------------------------------------------------------------
 
 
-def test_double_pendulum_energy_error_at_tight_tolerance():
-    req = SimulationRequest(
-        t_end=20, method="DOP853", rtol=1e-12, atol=1e-12, check_sensitivity=False
-    )
+@pytest.mark.parametrize(("method", "tol"), [("DOP853", 1e-12), ("dop853_c", 1e-11)])
+def test_double_pendulum_energy_error_at_tight_tolerance(method, tol):
+    """The issue's target (energy error ≤ 1e-9 over 20 s); dop853_c meets it at 1e-11, the
+    setting the 50 ms benchmark times."""
+    req = SimulationRequest(t_end=20, method=method, rtol=tol, atol=tol, check_sensitivity=False)
     r = simulate(scene_id="double_pendulum", request=req)
     p = load_scene("double_pendulum")["parameters"]
     m1, m2, l1, l2, g = (p[k] for k in ("m1", "m2", "l1", "l2", "g"))
@@ -453,7 +455,7 @@ def test_zero_duration_with_zero_drive_returns_the_initial_state():
 # --- blow-ups -------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("method", ["RK45", "DOP853", "dop853_fortran", "LSODA", "rk4"])
+@pytest.mark.parametrize("method", ["RK45", "DOP853", "dop853_fortran", "dop853_c", "LSODA", "rk4"])
 def test_a_blow_up_stops_with_the_partial_trajectory_and_says_when(method):
     """y' = y², y(0) = 1: y = 1/(1 − t), infinite at t = 1 (the output grid avoids t = 1)."""
     t_eval = np.linspace(0, 2, 200)
@@ -486,7 +488,7 @@ WELL = {
 }
 
 
-@pytest.mark.parametrize("method", ["DOP853", "LSODA", "dop853_fortran"])
+@pytest.mark.parametrize("method", ["DOP853", "LSODA", "dop853_fortran", "dop853_c"])
 def test_a_posted_scene_falling_into_a_singular_potential_stops_and_says_when(method):
     """V = −1/(1 − x)², released at rest at x = 0 (m = 1): ẋ²/2 = 1/(1 − x)² − 1 gives
     x(t) = 1 − sqrt(1 − 2t²), reaching the singularity x = 1 at t = 1/√2."""

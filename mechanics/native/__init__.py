@@ -34,6 +34,7 @@ import numpy as np
 import sympy as sp
 from scipy.integrate._ivp import dop853_coefficients as tableau
 from sympy.printing.c import C99CodePrinter
+from sympy.printing.codeprinter import PrintMethodNotImplementedError
 
 from mechanics.cache import cache_dir
 
@@ -269,10 +270,17 @@ def rhs_source(
     stray = set().union(*(e.free_symbols for e in exprs)) - set(slots.values())
     if stray:
         raise NativeUnavailable(f"unexpected symbols {sorted(map(str, stray))}")
-    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
-    printer = _Printer()
+    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"))
+    try:
+        return _assemble(n, temps, reduced, accelerations is not None)
+    except PrintMethodNotImplementedError as exc:
+        raise NativeUnavailable(f"cannot generate C: {str(exc).splitlines()[0]}") from exc
+
+
+def _assemble(n: int, temps: list, reduced: list, solved: bool) -> str:
+    printer = _Printer({"strict": True})
     lines = [f"    const double {s} = {printer.doprint(e)};" for s, e in temps]
-    if accelerations is not None:
+    if solved:
         lines += [f"    dy[{n + i}] = {printer.doprint(e)};" for i, e in enumerate(reduced[:n])]
     else:
         lines += [f"    a[{i}] = {printer.doprint(e)};" for i, e in enumerate(reduced[: n * n])]
@@ -280,7 +288,7 @@ def rhs_source(
     lines.append(f"    dy[{2 * n}] = {printer.doprint(reduced[-1])};")
     body = _checked("\n".join(lines))
     head = [f"    dy[{i}] = y[{n + i}];" for i in range(n)]
-    if accelerations is None:
+    if not solved:
         solve = [
             f"    if (lab_solve({n}, a, b)) return {RHS_SINGULAR};",
             *(f"    dy[{n + i}] = b[{i}];" for i in range(n)),
@@ -291,7 +299,7 @@ def rhs_source(
     return "\n".join(
         [
             "#include <math.h>",
-            _SOLVE if accelerations is None else "",
+            "" if solved else _SOLVE,
             "int lab_rhs(double t, const double *y, const double *p, double *dy) {",
             "    (void)t; (void)p;",
             *head,

@@ -49,7 +49,7 @@ def test_scene_page_renders_animates_reacts_and_round_trips(server, page, artifa
     assert int(p.get_attribute("#fbd-svg", "data-arrows")) >= 1
     assert p.locator("#plot-q .main-svg").count() > 0
     assert p.locator("#plot-energy .main-svg").count() > 0
-    assert "DOP853" in p.inner_text("#stats")
+    assert "dop853_c" in p.inner_text("#stats")  # the default: DOP853 compiled to C
 
     # the canvas advances: another frame, other pixels
     frame, pixels = p.get_attribute("#canvas", "data-frame"), p.evaluate(CANVAS_SUM, "canvas")
@@ -76,7 +76,7 @@ def test_scene_page_renders_animates_reacts_and_round_trips(server, page, artifa
     # the URL keeps the state ...
     state = parse_qs(urlparse(p.url).query)
     assert float(state[q][0]) == moved
-    assert state["method"] == ["DOP853"]
+    assert state["method"] == ["dop853_c"]
     p.screenshot(path=str(artifacts / f"{scene_id}.png"))
 
     # ... and a fresh load from it reproduces the same run exactly
