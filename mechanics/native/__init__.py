@@ -249,6 +249,13 @@ static int lab_solve(int n, double *a, double *b) {
 """
 
 
+def _expr(e: sp.Basic | int | float) -> sp.Basic:
+    """Sympy expressions pass; plain numbers become sympy numbers (never text: no sympify)."""
+    if isinstance(e, sp.Basic):
+        return e
+    return sp.Integer(e) if isinstance(e, int) else sp.Float(float(e))
+
+
 def rhs_source(
     args: Sequence[sp.Symbol],
     n: int,
@@ -266,7 +273,7 @@ def rhs_source(
     slots |= {a: sp.Symbol(f"y[{i}]") for i, a in enumerate(args[1 : 2 * n + 1])}
     slots |= {a: sp.Symbol(f"p[{k}]") for k, a in enumerate(args[2 * n + 1 :])}
     outputs = [*accelerations] if accelerations is not None else [*mass, *forcing]
-    exprs = [sp.sympify(e).xreplace(slots) for e in [*outputs, power]]
+    exprs = [_expr(e).xreplace(slots) for e in [*outputs, power]]
     stray = set().union(*(e.free_symbols for e in exprs)) - set(slots.values())
     if stray:
         raise NativeUnavailable(f"unexpected symbols {sorted(map(str, stray))}")
