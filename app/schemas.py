@@ -152,7 +152,7 @@ class SimulateRequest(DeriveRequest):
                     "scene_id": "double_pendulum",
                     "t_end": 20,
                     "fps": 60,
-                    "method": "DOP853",
+                    "method": "dop853_c",
                     "rtol": 1e-10,
                     "atol": 1e-10,
                 },
@@ -170,7 +170,8 @@ class SimulateRequest(DeriveRequest):
     method: str = Field(
         default="DOP853",
         description="euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
-        "RK45, DOP853, Radau, BDF, LSODA (adaptive: rtol, atol).",
+        "RK45, DOP853, dop853_c, dop853_fortran, Radau, BDF, LSODA (adaptive: rtol, atol); "
+        "`GET /api/v1/methods` lists each with its order and properties.",
     )
     rtol: float = Field(default=1e-9, description="Relative tolerance (adaptive methods).")
     atol: float = Field(default=1e-9, description="Absolute tolerance (adaptive methods).")
@@ -183,6 +184,20 @@ class SimulateRequest(DeriveRequest):
         default=False,
         description="Also return the constraint force on each body (and a rod's tension).",
     )
+
+
+class MethodOut(BaseModel):
+    """One integration method: what a student needs to pick it knowingly."""
+
+    name: str = Field(description="The value for `method`.")
+    label: str
+    kind: str = Field(description="fixed (give dt) or adaptive (give rtol, atol).")
+    order: int = Field(description="Order of accuracy (the maximum, for variable-order methods).")
+    symplectic: bool
+    implicit: bool
+    description: str
+    available: bool = Field(description="False when it would run as another method here.")
+    note: str = Field(default="", description="Why it is not available, and what runs instead.")
 
 
 class SimulateStats(BaseModel):

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
@@ -99,3 +101,34 @@ def test_nan_parameter_is_refused_and_server_keeps_serving():
 
 def test_unknown_scene_is_404():
     assert post(scene_id="no_such_scene").status_code == 404
+
+
+def test_the_methods_endpoint_lists_the_registry_and_the_pages_offer_every_method(monkeypatch):
+    from mechanics import native
+    from mechanics.integrators import METHODS
+
+    listed = client.get("/api/v1/methods").json()
+    assert [m["name"] for m in listed] == list(METHODS)
+    by_name = {m["name"]: m for m in listed}
+    assert by_name["rk4"]["order"] == 4 and by_name["rk4"]["kind"] == "fixed"
+    assert by_name["dop853_c"]["available"] and by_name["dop853_c"]["note"] == ""
+    js = (Path(__file__).parents[1] / "static/js/integrator.js").read_text()
+    offered = re.findall(r'\["(\w+)", "', js.split("export const METHODS")[1].split("];")[0])
+    assert sorted(offered) == sorted(METHODS)
+    # without a compiler the method still answers, and says what runs instead
+    monkeypatch.setenv(native.ENV_VAR, "none")
+    native._kernel.cache_clear()
+    try:
+        (c,) = [m for m in client.get("/api/v1/methods").json() if m["name"] == "dop853_c"]
+    finally:
+        native._kernel.cache_clear()
+    assert not c["available"] and "scipy's DOP853" in c["note"]
+
+
+def test_a_posted_scene_runs_compiled_in_the_budgeted_child_like_a_builtin():
+    spec = client.get("/api/v1/scenes/double_pendulum").json()["spec"]
+    a = post(scene=spec, t_end=3, method="dop853_c", rtol=1e-10, atol=1e-10).json()
+    b = post(scene_id="double_pendulum", t_end=3, method="DOP853", rtol=1e-10, atol=1e-10).json()
+    assert a["warnings"] == [] and a["stats"]["method"] == "dop853_c"
+    assert a["stats"]["steps"] == b["stats"]["steps"]
+    assert a["q"]["theta2"][-1] == pytest.approx(b["q"]["theta2"][-1], rel=1e-9)

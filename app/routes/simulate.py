@@ -9,7 +9,7 @@ from fastapi import APIRouter, Response
 
 from app.derivations import derive_seconds
 from app.routes.scenes import unknown_scene
-from app.schemas import Message, SimulateRequest, SimulateResponse, ValidationErrors
+from app.schemas import Message, MethodOut, SimulateRequest, SimulateResponse, ValidationErrors
 from mechanics.budget import run_with_budget
 from mechanics.scenes import scene_ids
 from mechanics.spec import parse_spec
@@ -47,6 +47,24 @@ def post_simulate(request: SimulateRequest) -> Response:
             simulate, scene=document, request=options, seconds=derive_seconds()
         )
     return Response(content=json.dumps(_finite(result)), media_type="application/json")
+
+
+@router.get("/methods", response_model=list[MethodOut], summary="List the integration methods")
+def get_methods() -> list[MethodOut]:
+    """The registry, in the order the pages offer it; `available` is false for ``dop853_c`` on a
+    server without a C compiler (it then runs scipy's DOP853, the same steps, more slowly)."""
+    from mechanics import native
+    from mechanics.integrators import METHODS
+
+    why = native.available()
+    return [
+        MethodOut(
+            **vars(m),
+            available=not (m.name == "dop853_c" and why),
+            note=f"runs scipy's DOP853 here: {why}" if m.name == "dop853_c" and why else "",
+        )
+        for m in METHODS.values()
+    ]
 
 
 def _finite(value):
