@@ -347,3 +347,18 @@ def test_the_generated_c_is_the_same_text_in_every_process():
         for seed in ("1", "2")
     }
     assert outputs == {compiled_scene("double_pendulum").native_source + "\n"}
+
+
+def test_the_disk_cache_of_libraries_stays_bounded(monkeypatch, tmp_path):
+    monkeypatch.setenv("LAGRANGE_LAB_CACHE", str(tmp_path))
+    monkeypatch.setattr(native, "MAX_LIBRARIES", 2)
+    native._rhs_library.cache_clear()
+    args = list(sp.symbols("t_ q_0 u_0"))
+    try:
+        for k in range(4):
+            src = native.rhs_source(args, 1, sp.S.Zero, accelerations=[-(k + 1) * args[1]])
+            rhs = native.compile_rhs(src, [], 3)
+            assert rhs(0.0, np.array([1.0, 0.0, 0.0]))[1] == -(k + 1)  # loaded ones keep working
+    finally:
+        native._rhs_library.cache_clear()
+    assert len(list((tmp_path / "native").glob("rhs-*.so"))) == 2

@@ -116,12 +116,24 @@ def _build(source: str, kind: str) -> ctypes.CDLL:
                         log.warning("C compile failed: %s", done.stderr[-2000:])
                         raise NativeUnavailable(f"the C compiler failed: {done.stderr[-300:]}")
                     os.replace(so_file, target)  # atomic: other processes see all or nothing
+                _prune(folder)
             except (OSError, subprocess.SubprocessError) as exc:
                 raise NativeUnavailable(f"could not compile C code: {exc}") from exc
         try:
             return ctypes.CDLL(str(target))
         except OSError as exc:
             raise NativeUnavailable(f"could not load the compiled library: {exc}") from exc
+
+
+#: Each posted scene leaves a library (~16 kB) behind; past this many the oldest go.
+MAX_LIBRARIES = 2000
+
+
+def _prune(folder: Path) -> None:
+    """Keep the cache bounded; a library in use stays mapped even when its file is removed."""
+    libraries = sorted(folder.glob("rhs-*.so"), key=lambda f: f.stat().st_mtime)
+    for old in libraries[: max(0, len(libraries) - MAX_LIBRARIES)]:
+        old.unlink(missing_ok=True)
 
 
 def _c_array(name: str, values: np.ndarray) -> str:
