@@ -1,4 +1,4 @@
-"""Benchmarks: ``python -m mechanics.bench derive`` (and ``integrate`` once simulation lands).
+"""Benchmarks: ``python -m mechanics.bench derive`` (and ``integrate``, in bench_integrate.py).
 
 Side by side in one process, per built-in scene: the engine's cold derivation (every step,
 simplified), its warm answer over HTTP, and sympy's LagrangesMethod followed by simplify() of the
@@ -25,8 +25,9 @@ def _size(exprs) -> int:
     return int(sum(sp.count_ops(e) for e in exprs))
 
 
-def _http_client():
-    """A real uvicorn server on a free loopback port (in a thread) and a keep-alive client."""
+def _http_server():
+    """A real uvicorn server on a free loopback port (in a thread) and a keep-alive client:
+    returns send(path, body) -> response bytes."""
     import http.client
     import json
     import socket
@@ -45,16 +46,21 @@ def _http_client():
         time.sleep(0.01)
     conn = http.client.HTTPConnection("127.0.0.1", port)
 
-    def post(scene_id: str) -> bytes:
-        body = json.dumps({"scene_id": scene_id})
-        conn.request("POST", "/api/v1/derive", body, {"content-type": "application/json"})
+    def send(path: str, body: dict) -> bytes:
+        conn.request("POST", path, json.dumps(body), {"content-type": "application/json"})
         response = conn.getresponse()
         data = response.read()
         if response.status != 200:
-            raise RuntimeError(f"{scene_id}: HTTP {response.status}")
+            raise RuntimeError(f"{path} {body}: HTTP {response.status}")
         return data
 
-    return post
+    return send
+
+
+def _http_client():
+    """POST /api/v1/derive for a scene id, over real HTTP."""
+    send = _http_server()
+    return lambda scene_id: send("/api/v1/derive", {"scene_id": scene_id})
 
 
 def bench_derive(ids: list[str], warm_runs: int = 50, baseline_budget: float = 60.0) -> list[dict]:
