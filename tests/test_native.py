@@ -362,3 +362,24 @@ def test_the_disk_cache_of_libraries_stays_bounded(monkeypatch, tmp_path):
     finally:
         native._rhs_library.cache_clear()
     assert len(list((tmp_path / "native").glob("rhs-*.so"))) == 2
+
+
+def test_shapes_are_checked_before_c_reads_or_writes_by_index():
+    """The generated C indexes params and the state blindly: a wrong shape must stop in Python."""
+    c = compiled_scene("double_pendulum")
+    p = _params(c)
+    with pytest.raises(ValueError, match="params"):
+        native.compile_rhs(c.native_source, p[:-1], 5)
+    with pytest.raises(ValueError, match="states"):
+        native.compile_rhs(c.native_source, p, 3)
+    rhs = c.native_rhs(p)
+    with pytest.raises(ValueError, match="y0 has 3"):
+        native.dop853(
+            rhs,
+            np.zeros(3),
+            np.linspace(0, 1, 3),
+            rtol=1e-6,
+            atol=1e-6,
+            max_steps=10,
+            max_seconds=1,
+        )

@@ -291,12 +291,12 @@ def rhs_source(
         raise NativeUnavailable(f"unexpected symbols {sorted(map(str, stray))}")
     temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"))
     try:
-        return _assemble(n, temps, reduced, accelerations is not None)
+        return _assemble(n, len(args) - 2 * n - 1, temps, reduced, accelerations is not None)
     except PrintMethodNotImplementedError as exc:
         raise NativeUnavailable(f"cannot generate C: {str(exc).splitlines()[0]}") from exc
 
 
-def _assemble(n: int, temps: list, reduced: list, solved: bool) -> str:
+def _assemble(n: int, n_params: int, temps: list, reduced: list, solved: bool) -> str:
     printer = _Printer({"strict": True})
     lines = [f"    const double {s} = {printer.doprint(e)};" for s, e in temps]
     if solved:
@@ -317,6 +317,7 @@ def _assemble(n: int, temps: list, reduced: list, solved: bool) -> str:
         solve = []
     return "\n".join(
         [
+            f"/* lab: dim {2 * n + 1} params {n_params} */",
             "#include <math.h>",
             "" if solved else _SOLVE,
             "int lab_rhs(double t, const double *y, const double *p, double *dy) {",
@@ -359,8 +360,19 @@ class NativeRhs:
         return out
 
 
+_SHAPE = re.compile(r"/\* lab: dim (\d+) params (\d+) \*/")
+
+
 def compile_rhs(source: str, params: Sequence[float], dim: int) -> NativeRhs:
-    """Build (or load from the disk cache) a generated right-hand side; bind parameters."""
+    """Build (or load from the disk cache) a generated right-hand side; bind parameters.
+
+    The C reads params and writes dy by index, so the shapes are checked against the ones
+    `rhs_source` recorded: a mismatch here would be memory corruption there."""
+    shape = _SHAPE.match(source)
+    if shape is None or (int(shape[1]), int(shape[2])) != (dim, len(params)):
+        raise ValueError(
+            f"the source is not a right-hand side of {dim} states, {len(params)} params"
+        )
     lib = _rhs_library(source)
     return NativeRhs(lib, np.ascontiguousarray(params, dtype=float), dim)
 
@@ -405,6 +417,8 @@ def dop853(
     result = _Result()
     failure: list[BaseException] = []
     if isinstance(rhs, NativeRhs):
+        if rhs.dim != dim:
+            raise ValueError(f"the compiled right-hand side has {rhs.dim} states, y0 has {dim}")
         address, params, keep = rhs.address, rhs.params, None
     else:
 
