@@ -201,6 +201,22 @@ def test_compare_mode_shows_two_runs_and_their_costs(server, page, artifacts):
     assert page.errors == []
 
 
+def test_comparing_the_compiled_and_scipy_dop853_shows_the_same_steps(server, page):
+    """What a student sees when comparing the two DOP853s: the same steps, evaluations and
+    accuracy; only the wall time differs."""
+    p = page.page
+    p.goto(f"{server}/scenes/simple_pendulum?compare=1&method=dop853_c&method_b=DOP853&t_end=10")
+    wait_ready(page)
+    rows = {
+        r.locator("th").inner_text(): [c.inner_text() for c in r.locator("td").all()]
+        for r in p.locator("#stats tbody tr").all()
+    }
+    assert rows["method"] == ["dop853_c", "DOP853"]
+    assert rows["steps"][0] == rows["steps"][1] and rows["steps"][0] != "0"
+    assert rows["RHS evaluations"][0] == rows["RHS evaluations"][1]
+    assert page.errors == []
+
+
 def test_a_3d_scene_turns_when_dragged(server, page):
     p = page.page
     p.goto(f"{server}/scenes/spherical_pendulum")
