@@ -9,7 +9,7 @@ import time
 
 import pytest
 import sympy as sp
-from sympy.physics.vector import dynamicsymbols
+from sympy.physics.vector import ReferenceFrame, dynamicsymbols
 
 from mechanics.expr import (
     FUNCTIONS,
@@ -101,6 +101,10 @@ def warm_up():
         ("m*l**2*theta_dot**2/2", m * l**2 * theta.diff(t) ** 2 / 2),
         ("  m +\tg  ", m + g),
         ("(m\n+ g)", m + g),
+        ("g**2**3", g**8),
+        ("-(m + g)", -m - g),
+        ("1e-3*g", g / 1000),
+        ("2*pi*sqrt(l/g)", 2 * sp.pi * sp.sqrt(l / g)),
     ],
 )
 def test_operators_and_precedence(text, expected):
@@ -189,6 +193,8 @@ def test_function_values_are_sympy_values():
         ("2E2", sp.Integer(200)),
         ("1e6", sp.Integer(10**6)),
         ("-0.5", sp.Rational(-1, 2)),
+        ("2.5e-3", sp.Rational(1, 400)),
+        ("0.123456", sp.Rational(123456, 1_000_000)),
     ],
 )
 def test_numbers(text, expected):
@@ -221,6 +227,10 @@ def test_long_or_tiny_decimals_keep_their_value(text):
 )
 def test_python_numbers_are_accepted(number, expected):
     assert parse(number, NAMES) == expected
+
+
+def test_a_python_float_with_many_digits_stays_a_float():
+    assert isinstance(parse(3.14159265358979, NAMES), sp.Float)
 
 
 # --- refusals -----------------------------------------------------------------------------------
@@ -284,6 +294,17 @@ def test_python_numbers_are_accepted(number, expected):
         ("m $ g", ["$"]),
         ("m\x00", ["character"]),
         ("θ", ["θ", "character"]),
+        ("m\u00a0+ 1", ["character"]),
+        ("m(g)", ["write '*'"]),
+        ("(m*g)(1)", ["listed functions"]),
+        ("sin(**m)", ["keyword"]),
+        ("1 +* 2", ["syntax"]),
+        ("...", ["..."]),
+        ("1e308*1e308", ["finite"]),
+        ("1e300*1e300*m", ["finite"]),
+        ("exp(1000)", ["finite"]),
+        ("m**-100", ["exponent"]),
+        ("(2**60)**60", ["too large"]),
     ],
 )
 def test_refusals_say_what_and_carry_the_field(text, says):
@@ -302,6 +323,22 @@ def test_unknown_name_is_named_and_points_at_it():
         p("m*g*lenght")
     assert "'lenght'" in info.value.message
     assert info.value.position == 4
+
+
+def test_an_unknown_name_lists_the_known_ones_when_they_are_few():
+    with pytest.raises(ExprError) as info:
+        parse("lenght", {"length": l, "mass": m})
+    message = info.value.message
+    assert "'lenght'" in message and "length" in message and "mass" in message
+
+
+@pytest.mark.parametrize(
+    ("text", "position"), [("m ^ 2", 2), ("  1 +* 2", 5), ("m + lenght", 4), ("(m + 1", 0)]
+)
+def test_positions_point_into_the_original_text(text, position):
+    with pytest.raises(ExprError) as info:
+        p(text)
+    assert info.value.position == position
 
 
 def test_caret_suggests_double_star():
@@ -378,6 +415,7 @@ def timed(text):
         "-" + "9" * 40,
         "exp(exp(exp(exp(9))))**2",
         "2**exp(exp(exp(exp(9))))",
+        "+".join(["m"] * 1500),
     ],
     ids=lambda s: s if len(s) < 30 else f"{s[:12]}...({len(s)} chars)",
 )
@@ -428,6 +466,30 @@ def test_long_chains_under_the_cap_are_fine_or_refused_but_fast(text, expected):
     # not against a busy machine (speed is measured by the benchmarks, not by tests)
     assert elapsed < 1.0, f"{elapsed:.3f} s"
     assert isinstance(result, ExprError) or result == expected
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "(" * (MAX_DEPTH + 1) + "m" + ")" * (MAX_DEPTH + 1),
+        "sin(" * (MAX_DEPTH + 1) + "m" + ")" * (MAX_DEPTH + 1),
+        "-" * 500 + "m",
+    ],
+    ids=["parentheses", "calls", "signs"],
+)
+def test_too_deep_nesting_says_so(text):
+    result, elapsed = timed(text)
+    assert isinstance(result, ExprError) and "deeper" in result.message
+    assert elapsed < FAST
+
+
+def test_long_sums_and_products_of_distinct_names_are_not_deep_nesting():
+    """An equation of motion can have many more terms than MAX_DEPTH."""
+    symbols = sp.symbols(f"a0:{MAX_DEPTH * 4}")
+    names = {str(s): s for s in symbols}
+    text = " + ".join(f"{s}*{s}" for s in symbols[:-1]) + f" - {symbols[-1]}"
+    assert parse(text, names) == sp.Add(*(s**2 for s in symbols[:-1])) - symbols[-1]
+    assert parse("*".join(map(str, symbols)), names) == sp.Mul(*symbols)
 
 
 def test_a_long_but_honest_sum_is_parsed():
@@ -483,9 +545,12 @@ def test_free_names():
     assert free_names("atan2(y, x) + theta_dot**2") == {"y", "x", "theta_dot"}
     assert free_names("3 + 4") == set()
     assert free_names("lenght*m") == {"lenght", "m"}
+    assert free_names("2 + foo(3)") == {"foo"}  # unknown functions are the caller's to report
 
 
-@pytest.mark.parametrize("text", ["", "m^2", "x.__class__", "x" * 100_000, "m +", "'a'"])
+@pytest.mark.parametrize(
+    "text", ["", "m^2", "x.__class__", "x" * 100_000, "m +", "'a'", "__import__('os')"]
+)
 def test_free_names_refuses_what_parse_refuses(text):
     with pytest.raises(ExprError):
         free_names(text)
@@ -514,6 +579,11 @@ ROUND_TRIP = [
     sp.E * m,
     -(m1 + m2) * g * t**2 / 2 + sp.Rational(1, 2),
     x ** sp.Rational(3, 2) - x ** sp.Rational(-1, 3),
+    sp.Float(0.123456789012, 15) * g,
+    sp.Rational(-3, 7) * g**-3 + 1 / sp.sqrt(m),
+    2 * sp.pi * (l + pd) ** 3,
+    sp.sec(theta) * sp.csc(phi) * sp.cot(t),
+    sp.Abs(td) * sp.sign(pd),
 ]
 
 
@@ -534,6 +604,11 @@ def test_plain_text_convention():
     assert to_plain(sp.Abs(theta)) == "abs(theta)"
     assert to_plain(m * g) in {"m*g", "g*m"}
     assert to_plain([m, theta]) in {"[m, theta]"}
+    assert to_plain([g, [m, 1]]) == "[g, [m, 1]]"
+    assert to_plain(sp.sqrt(g)) == "sqrt(g)"
+    assert to_plain(m * g * l / 2) == "g*l*m/2"
+    assert to_plain(sp.Float(0.1) * g) == "0.1*g"
+    assert to_plain(td**2 * m) == "m*theta_dot**2"
 
 
 def test_a_float_prints_as_a_number_that_parses_back():
@@ -553,6 +628,18 @@ def test_latex_dots_and_greek():
     assert r"\ddot{\theta}" in to_latex(p("theta_ddot + g/l*sin(theta)"))
     assert r"\sin{\left(\theta \right)}" in to_latex(p("sin(theta)"))
     assert "(t)" not in to_latex(p("theta*phi_dot"))
+
+
+def test_latex_greek_names_and_written_subscripts():
+    for name in ["phi", "omega", "Omega", "alpha", "mu"]:
+        assert to_latex(sp.Symbol(name)) == "\\" + name
+    assert to_latex(sp.Symbol("l_2")) == "l_{2}"
+
+
+def test_latex_accepts_vectors():
+    N = ReferenceFrame("N")
+    text = to_latex(l * sp.sin(theta) * N.x)
+    assert r"\theta" in text and r"\mathbf{\hat{n}_x}" in text
 
 
 def test_latex_subscripts_digits():
