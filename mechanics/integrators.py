@@ -99,6 +99,15 @@ class _Stop(Exception):
     """Ends a run early; the message says why and when."""
 
 
+#: What a right-hand side raises because of the motion (math.exp overflow, a singular M), not
+#: because of a bug: the run stops and says so instead of raising.
+_PHYSICAL = (ArithmeticError, np.linalg.LinAlgError)
+
+
+def _physical_stop(exc: BaseException, t: float) -> str:
+    return f"{type(exc).__name__} near t = {t:.6g} s: {exc}"
+
+
 def _finite(v: np.ndarray) -> bool:
     """All entries finite? A sum of Python floats is ten times cheaper than np.isfinite on the
     few numbers of a state, and it runs on every RHS call (NaN and ±inf propagate into it)."""
@@ -214,8 +223,8 @@ def integrate(
                 _adaptive(run, _SCIPY[method], f, y0, t_eval, rtol, atol, max_steps)
     except _Stop as stop:
         status, message = "stopped", str(stop)
-    except (ArithmeticError, np.linalg.LinAlgError) as exc:  # e.g. math.exp overflow in the rhs
-        status, message = "stopped", f"{type(exc).__name__} near t = {f.t:.6g} s: {exc}"
+    except _PHYSICAL as exc:
+        status, message = "stopped", _physical_stop(exc, f.t)
     return Trajectory(
         t_eval[: len(run.out)].copy(),
         np.array(run.out),
@@ -238,9 +247,6 @@ _NATIVE_STOPS = {
 }
 
 
-_PHYSICAL = (ArithmeticError, np.linalg.LinAlgError)  # a property of the motion, not a bug
-
-
 def _compiled(rhs, y0, t_eval, rtol, atol, max_steps, budget, start) -> Trajectory:
     """The C loop: same algorithm as scipy's DOP853; the statuses map onto the same messages."""
     r = native_code.dop853(
@@ -254,7 +260,7 @@ def _compiled(rhs, y0, t_eval, rtol, atol, max_steps, budget, start) -> Trajecto
         elif r.error is not None and not isinstance(r.error, _PHYSICAL):
             raise r.error  # a bug in the caller's function, not a property of the motion
         elif r.error is not None:
-            message = f"{type(r.error).__name__} near t = {r.t_reached:.6g} s: {r.error}"
+            message = _physical_stop(r.error, r.t_reached)
         elif r.rhs_code == native_code.RHS_SINGULAR:
             message = f"the mass matrix became singular at t = {r.t_reached:.6g} s"
         else:
