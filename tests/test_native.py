@@ -383,3 +383,24 @@ def test_shapes_are_checked_before_c_reads_or_writes_by_index():
             max_steps=10,
             max_seconds=1,
         )
+
+
+def test_a_broken_compiler_is_not_run_again_on_every_request(monkeypatch, tmp_path):
+    monkeypatch.setenv("LAGRANGE_LAB_CACHE", str(tmp_path))
+    monkeypatch.setenv(native.ENV_VAR, "false")
+    native._kernel.cache_clear()
+    native._rhs_library.cache_clear()
+    runs = []
+    real = subprocess.run
+    monkeypatch.setattr(subprocess, "run", lambda *a, **k: runs.append(a) or real(*a, **k))
+    req = SimulationRequest(method="dop853_c", t_end=1)
+    try:
+        simulate("simple_pendulum", request=req)
+        first = len(runs)
+        r = simulate("simple_pendulum", request=req)
+    finally:
+        native._kernel.cache_clear()
+        native._rhs_library.cache_clear()
+    assert 1 <= first <= 2  # the loop, and the scene's C if it was tried
+    assert len(runs) == first  # the second request (and its sensitivity re-run) ran nothing
+    assert any("compiler failed" in w for w in r["warnings"])

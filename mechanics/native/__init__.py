@@ -84,6 +84,9 @@ def compiler() -> str | None:
 
 _locks: dict[str, threading.Lock] = {}
 _locks_guard = threading.Lock()
+#: Sources this compiler refused, by (compiler, library path): a broken compiler is run once
+#: per source and process, not again on every request (a different compiler is tried afresh).
+_refused: dict[tuple[str, str], NativeUnavailable] = {}
 
 
 def _build(source: str, kind: str) -> ctypes.CDLL:
@@ -100,6 +103,8 @@ def _build(source: str, kind: str) -> ctypes.CDLL:
     with _locks_guard:
         lock = _locks.setdefault(digest, threading.Lock())
     with lock:
+        if (cc, str(target)) in _refused:
+            raise _refused[cc, str(target)]
         if not target.exists():
             try:
                 folder.mkdir(parents=True, exist_ok=True)
@@ -114,7 +119,9 @@ def _build(source: str, kind: str) -> ctypes.CDLL:
                     )
                     if done.returncode != 0:
                         log.warning("C compile failed: %s", done.stderr[-2000:])
-                        raise NativeUnavailable(f"the C compiler failed: {done.stderr[-300:]}")
+                        failure = NativeUnavailable(f"the C compiler failed: {done.stderr[-300:]}")
+                        _refused[cc, str(target)] = failure
+                        raise failure
                     os.replace(so_file, target)  # atomic: other processes see all or nothing
                 _prune(folder)
             except (OSError, subprocess.SubprocessError) as exc:
