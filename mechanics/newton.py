@@ -19,7 +19,7 @@ from sympy.physics.vector import Vector
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
 from mechanics.steps import Line, Step, sub, tidy, vec_in, vec_line
-from mechanics.steps.fbd import body_forces
+from mechanics.steps.fbd import body_forces, rod_anchor
 
 
 @dataclass
@@ -105,19 +105,20 @@ def _potential_force(m: Any, V: sp.Expr) -> Vector | None:
 
 
 def _support_force(b: Any, R: Vector, m: Any) -> tuple[str, sp.Expr] | None:
-    """Tension toward the point a body hangs from, when the distance to it is fixed (a rod)."""
+    """Tension toward the point a particle hangs from, when a rod of fixed length is its only
+    constraint (`rod_anchor`): a bead on a spinning hoop keeps its distance from the centre too,
+    but the hoop's push is a normal force, not a tension; a rigid body's pin reaction is not one
+    either (it has a part across the line to the pin)."""
     hangers = [
         x for x in [*m.spec.bodies, *m.spec.points] if getattr(x.position, "from_", None) == b.name
     ]
     if hangers:  # another body pulls on it too: R is not one rod's tension
         return None
-    spec_body = next(x for x in m.spec.bodies if x.name == b.name)
-    anchor = getattr(spec_body.position, "from_", None) or "O"
-    rel = b.position - m.positions[anchor]
-    length2 = tidy(rel.dot(rel), m)
-    if length2 == 0 or any(length2.has(q) for q in m.q) or length2.has(sp.Symbol("t")):
+    anchor = rod_anchor(m, b.name)
+    if anchor is None:
         return None
-    tension = tidy(-R.dot(rel) / sp.sqrt(length2), m)
+    rel = b.position - m.positions[anchor]
+    tension = tidy(-R.dot(rel) / sp.sqrt(tidy(rel.dot(rel), m)), m)
     return anchor, tension
 
 

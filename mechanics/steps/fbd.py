@@ -1,12 +1,26 @@
-"""Step 1 (notes IV.A 1): the free-body diagram — every force on every body, frames, datum."""
+"""Step 1 (notes IV.A 1): the free-body diagram — every force on every body, frames, datum.
+
+Besides the applied forces, each body's constraint forces are named the way a textbook names them
+and placed where they act (`constraint_forces`): a rod's tension T at a bob, a track's or a wire's
+normal force N, a pin reaction R at the pin, the normal force N and static friction f_s at a
+rolling contact. Only the names, the points and the directions come from here (kinematics alone);
+the sizes are Newton's (`mechanics.newton`, R = m a − ΣF along a run).
+"""
 
 from __future__ import annotations
 
+import random
+from typing import Any
+
+import sympy as sp
 from sympy.physics.vector import Vector
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
+
+#: A kinematic quantity counts as zero when it is below this at every sampled state.
+ZERO = 1e-9
 
 
 def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
@@ -33,9 +47,377 @@ def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
     return acting
 
 
+# ---------------------------------------------------------------------------- kinematic tests
+class _Sampler:
+    """A few random states (q, q̇, t, parameters) at which kinematic identities are tested."""
+
+    def __init__(self, model: Model, n: int = 4) -> None:
+        rng = random.Random(7)
+        t = model.names["t"]
+        self.model = model
+        self.states = []
+        for _ in range(n):
+            s: dict[Any, Any] = {p: sp.Float(rng.uniform(0.4, 1.3)) for p in model.params.values()}
+            s.update({q: sp.Float(rng.uniform(0.2, 1.1)) for q in [*model.qdd, *model.qd]})
+            s.update({q: sp.Float(rng.uniform(0.2, 1.1)) for q in model.q})
+            s[t] = sp.Float(rng.uniform(0.2, 1.1))
+            self.states.append(s)
+
+    def values(self, v: Vector) -> list[list[float]]:
+        N = self.model.N
+        comps = [v.dot(u) for u in (N.x, N.y, N.z)]
+        return [[float(c.subs(s)) for c in comps] for s in self.states]
+
+    def zero(self, v: Vector) -> bool:
+        return all(abs(x) <= ZERO for row in self.values(v) for x in row)
+
+    def rank(self, vectors: list[Vector]) -> int:
+        import numpy as np
+
+        if not vectors:
+            return 0
+        return max(
+            int(np.linalg.matrix_rank(np.array(rows), tol=1e-7))
+            for rows in zip(*(self.values(v) for v in vectors), strict=True)
+        )
+
+
+def _explicit_t(v: Vector, model: Model) -> Vector:
+    """∂v/∂t at fixed q: nonzero only for a constraint that moves with time (a spinning hoop)."""
+    plain = {q: sp.Dummy() for q in model.q}
+    back = {d: q for q, d in plain.items()}
+    t = model.names["t"]
+    N = model.N
+    return sum(
+        (v.dot(u).xreplace(plain).diff(t).xreplace(back) * u for u in (N.x, N.y, N.z)), Vector(0)
+    )
+
+
+def _planar(model: Model, s: _Sampler) -> bool:
+    """Everything happens in the x–y plane of N: bodies, forces and every turn about N.z."""
+    z = model.N.z
+    if any(not s.zero(p.dot(z) * z) for p in model.positions.values()):
+        return False
+    for info in model.frames.values():
+        w = info.frame.ang_vel_in(model.N)
+        if not s.zero(w - w.dot(z) * z):
+            return False
+    return True
+
+
+def _anchor(model: Model, name: str) -> str:
+    spec_body = next(x for x in model.spec.bodies if x.name == name)
+    return getattr(spec_body.position, "from_", None) or "O"
+
+
+def _hangers(model: Model, name: str) -> list[str]:
+    """Bodies placed from this one (`from`)."""
+    return [b.name for b in model.bodies if b.name != name and _anchor(model, b.name) == name]
+
+
+def _chain(model: Model, name: str) -> set[str]:
+    """The body, every body it is placed from, and every body placed from it (transitively)."""
+    up, x = {name}, name
+    while (x := _anchor(model, x)) in {b.name for b in model.bodies}:
+        up.add(x)
+    down, todo = set(), [name]
+    while todo:
+        for h in _hangers(model, todo.pop()):
+            down.add(h)
+            todo.append(h)
+    return up | down
+
+
+def _directions(model: Model, place: Vector) -> list[Vector]:
+    return [place.diff(q, model.N) for q in model.q]
+
+
+def _moved_by(model: Model, v: Vector, s: _Sampler) -> list:
+    return [q for q in model.q if not s.zero(v.diff(q, model.N))]
+
+
+# ---------------------------------------------------------------------------- classification
+def rod_anchor(model: Model, name: str, sampler: _Sampler | None = None) -> str | None:
+    """The place a particle hangs from by a rod (or string), when that rod is its only constraint.
+
+    It keeps a fixed distance from its anchor, the constraint does not move with time, and
+    relative to the anchor it may move in every direction but along the rod: then its own
+    constraint force is the rod's pull along the rod, a tension T. A bead on a spinning hoop keeps
+    its distance too, but the hoop also pushes it across: that is a normal force, not a tension.
+    """
+    s = sampler or _Sampler(model)
+    body = next(b for b in model.bodies if b.name == name)
+    if body.kind != "particle":
+        return None
+    anchor = _anchor(model, name)
+    rel = model.positions[name] - model.positions[anchor]
+    length2 = tidy(rel.dot(rel), model)
+    if length2 == 0 or any(length2.has(q) for q in model.q) or length2.has(model.names["t"]):
+        return None
+    if not s.zero(_explicit_t(rel, model)):
+        return None
+    free = 2 if _planar(model, s) else 3
+    return anchor if s.rank(_directions(model, rel)) == free - 1 else None
+
+
+def _unit(v: Vector, model: Model) -> list[str]:
+    n = sp.sqrt(tidy(v.dot(v), model))
+    return [to_plain(tidy(v.dot(u) / n, model)) for u in (model.N.x, model.N.y, model.N.z)]
+
+
+def _point(v: Vector, model: Model) -> list[str]:
+    return [to_plain(tidy(v.dot(u), model)) for u in (model.N.x, model.N.y, model.N.z)]
+
+
+def _force(
+    name: str, on: str, what: str, at: str | list[str], label_of: str | None = None, **how: Any
+) -> dict[str, Any]:
+    letter, _, index = name.partition("_")
+    label = rf"\vec{{{letter}}}_{{{index + ',' if index else ''}{sub(label_of or on)}}}"
+    symbol = [letter, f"{index},{label_of or on}" if index else (label_of or on)]
+    return {"name": name, "label": label, "symbol": symbol, "what": what, "on": on, "at": at, **how}
+
+
+def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], str] | None:
+    """A planar rigid body moved by one coordinate: its constraints act at the point at rest.
+
+    The instantaneous centre P = G + ẑ × v_G / ω has zero velocity; if it is fixed in space it is
+    a pin (reaction R), else the body rolls on the path P traces (normal force N across it, static
+    friction f_s along it — no slip, so friction is static).
+    """
+    moves = _moved_by(model, body.position, s)
+    t = model.names["t"]
+    if body.frame is None or len(moves) != 1 or not _planar(model, s):
+        return None
+    if not s.zero(_explicit_t(body.position, model)):
+        return None
+    q = moves[0]
+    qd = model.qd[model.q.index(q)]
+    w = body.frame.ang_vel_in(model.N).dot(model.N.z)
+    one = {qd: 1}
+    omega = tidy(w.subs(one), model)
+    if omega == 0 or omega.has(t):
+        return None
+    v = body.position.dt(model.N).subs(one)
+    centre = body.position + model.N.z.cross(v) / omega
+    centre = sum(
+        (tidy(centre.dot(u), model) * u for u in (model.N.x, model.N.y, model.N.z)), Vector(0)
+    )
+    at = _point(centre, model)
+    name = body.name
+    if s.zero(centre.diff(q, model.N)):
+        pin = next((p for p, r in model.positions.items() if s.zero(r - centre)), None)
+        where = f"the pin at {pin}" if pin else "the pin"
+        force = _force("R", name, f"pin reaction on {name}, at {where}", at, part="rest")
+        return [force], (
+            f"the pin reaction R acts at {where}, a point of {name} that never moves: its virtual "
+            f"displacement is zero, so R does no virtual work (though R is not perpendicular to "
+            f"∂r_G/∂${to_latex(q)}$ in general)"
+        )
+    tangent = centre.diff(q, model.N)
+    normal = model.N.z.cross(tangent)
+    if tidy((body.position - centre).dot(normal), model).subs(s.states[0]) < 0:
+        normal = -normal
+    forces = [
+        _force(
+            "N",
+            name,
+            f"normal force on {name} at the contact",
+            at,
+            part="rest",
+            along=_unit(normal, model),
+        ),
+        _force(
+            "f_s",
+            name,
+            f"static friction on {name} at the contact",
+            at,
+            part="rest",
+            along=_unit(tangent, model),
+        ),
+    ]
+    return forces, (
+        f"N and f_s act at the contact point, the point of {name} at rest while it rolls "
+        "without slipping: its virtual displacement is zero, so they do no virtual work (though "
+        f"f_s is along ∂r_G/∂${to_latex(q)}$)"
+    )
+
+
+def _coupled_to(model: Model, name: str, s: _Sampler) -> list[str]:
+    """Other bodies, not hanging from it nor holding it, that its own coordinates move too."""
+    body = next(b for b in model.bodies if b.name == name)
+    rel = model.positions[name] - model.positions[_anchor(model, name)]
+    mine = set(_moved_by(model, rel, s))
+    if body.frame is not None:
+        w = body.frame.ang_vel_in(model.N)
+        mine |= {
+            q for q, qd in zip(model.q, model.qd, strict=True) if not s.zero(w.diff(qd, model.N))
+        }
+    chain = _chain(model, name)
+    return [
+        b.name
+        for b in model.bodies
+        if b.name not in chain and mine & set(_moved_by(model, model.positions[b.name], s))
+    ]
+
+
+def _straight_rope(model: Model, name: str, s: _Sampler) -> bool:
+    """Moves along one fixed vertical line, and every applied force on it is along that line:
+    what holds it back along the line is a rope's pull."""
+    J = [d for d in _directions(model, model.positions[name]) if not s.zero(d)]
+    if len(J) != 1 or model.gravity is None or not s.zero(_explicit_t(J[0], model)):
+        return False
+    line = J[0]
+    if any(not s.zero(line.diff(q, model.N)) for q in model.q):
+        return False
+    applied = sum((v for _, k, v in body_forces(model)[name] if k != "torque"), Vector(0))
+    return s.zero(model.gravity[1].cross(line)) and s.zero(applied.cross(line))
+
+
+def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], list[str]]:
+    """Each body's constraint forces, named and placed, and one true sentence per body on their
+    virtual work (per body only where it is provable; for the system, eq. 18–20)."""
+    s = _Sampler(model)
+    names = {b.name for b in model.bodies}
+    rods = {b.name: rod_anchor(model, b.name, s) for b in model.bodies}
+    forces: dict[str, list[dict[str, Any]]] = {b.name: [] for b in model.bodies}
+    for b, anchor in rods.items():
+        if anchor in names:  # the rod from `anchor` to b pulls on both its ends
+            forces[anchor].append(
+                _force(
+                    "T",
+                    anchor,
+                    f"pull of the rod from {anchor} to {b}",
+                    anchor,
+                    part="pull",
+                    rod=b,
+                    label_of=b,
+                )
+            )
+    notes = []
+    for body in model.bodies:
+        name = body.name
+        moves = _moved_by(model, body.position, s)
+        coords = ", ".join(to_latex(q) for q in moves)
+        if not moves and body.frame is None:
+            notes.append(f"{name}: held fixed by its constraints")
+            continue
+        coupled = _coupled_to(model, name, s)
+        hangers = _hangers(model, name)
+        anchor = _anchor(model, name)
+        fixed_anchor = (
+            anchor not in names
+            and s.zero(_explicit_t(model.positions[anchor], model))
+            and not _moved_by(model, model.positions[anchor], s)
+        )
+        alone = not coupled and not hangers and fixed_anchor
+        driven = not s.zero(_explicit_t(body.position, model))
+        free = 2 if _planar(model, s) else 3
+        own = None  # (force entries, why they do no virtual work) when provable
+        if rods[name] is not None:
+            rod = rods[name]
+            own = (
+                [
+                    _force(
+                        "T",
+                        name,
+                        f"tension of the rod from {rod} to {name}",
+                        name,
+                        part="rest",
+                        toward=rod,
+                    )
+                ],
+                "the rod's pull T is along the rod",
+            )
+        elif body.kind == "particle":
+            k = s.rank(_directions(model, body.position))
+            if not coupled and k < free:
+                where = "track" if k == 1 else "surface"
+                own = (
+                    [
+                        _force(
+                            "N", name, f"normal force of the {where} on {name}", name, part="rest"
+                        )
+                    ],
+                    f"the {where}'s normal force N is across it",
+                )
+            elif coupled and _straight_rope(model, name, s):
+                forces[name].append(
+                    _force("T", name, f"pull of the rope on {name}", name, part="rest")
+                )
+            elif coupled or k < free:
+                forces[name].append(
+                    _force("R", name, f"constraint force on {name}", name, part="rest")
+                )
+        elif not coupled and (contact := _rigid_contact(model, body, s)) is not None:
+            forces[name] += contact[0]
+            if alone:
+                notes.append(f"{name}: it moves only with ${coords}$; {contact[1]}")
+                continue
+        else:
+            forces[name].append(
+                _force(
+                    "R",
+                    name,
+                    f"resultant of the constraint forces on "
+                    f"{name} (drawn at its centre; a constraint moment too)",
+                    name,
+                    part="rest",
+                )
+            )
+        if own is not None:
+            forces[name] += own[0]
+        if alone and own is not None:
+            note = (
+                f"{name}: its only constraint is its own; it moves only with ${coords}$, and "
+                f"{own[1]}, perpendicular to every ∂r/∂q_j, so it does no virtual work"
+            )
+            if driven:
+                note += (
+                    " (the constraint moves with time, so it does do real work: a virtual "
+                    "displacement is taken at fixed t)"
+                )
+        elif alone and body.kind == "particle" and not forces[name]:
+            note = f"{name}: no constraint acts on it (it moves freely with ${coords}$)"
+        else:
+            why = []
+            if coupled:
+                why.append(f"its coordinates also move {', '.join(coupled)}")
+            if hangers:
+                why.append(f"{', '.join(hangers)} hang{'s' if len(hangers) == 1 else ''} from it")
+            if not fixed_anchor:
+                why.append(f"it hangs from {anchor}, which moves")
+            note = (
+                f"{name}: moves with ${coords}$; {' and '.join(why) or 'it shares constraints'}"
+                f", so the constraint forces on {name} need not be perpendicular to every "
+                f"∂r/∂q_j: on {name} alone they may do virtual work, summed over all bodies they "
+                "do none (ideal constraints, eq. 18–20)"
+            )
+        notes.append(note)
+    return forces, notes
+
+
 def free_body_diagram(model: Model, work: Work) -> Step:
-    """Forces as vectors, constraint forces named (they do no virtual work), frames and datum."""
+    """Forces as vectors, constraint forces named and placed, frames and datum.
+
+    ``data``:
+      ``bodies``: per body ``{"body", "kind", "free_directions", "forces", "constraint_forces"}``;
+        ``forces`` are the applied ones (label, kind, plain, components in N);
+        ``constraint_forces`` each ``{"name", "label", "what", "on", "at", "part", ...}``:
+        ``name`` as a textbook writes it (T tension of a rod or rope, N normal force, f_s static
+        friction, R pin reaction or an unnamed resultant; ``symbol``: its letter and subscript
+        in plain text, ``what``: in words), ``at`` where it acts: a place of the
+        run's ``positions`` (a body, a point) or its N components as plain expressions in the
+        coordinates and parameters (a pin, a rolling contact). Its size comes from Newton's
+        constraint force R_on = m a − ΣF of the run (`constraint_forces` of /simulate):
+        ``part = "pull"``: the rod of body ``rod`` pulls this end toward ``rod`` with that rod's
+        tension; ``part = "rest"``: R_on less the pulls listed on the same body, projected on
+        ``along`` (unit vector, N components) or on the direction ``toward`` a place when given.
+      ``constraints``: one sentence per body on the virtual work of its constraint forces.
+      ``datum``: where V = 0.
+    """
     acting = body_forces(model)
+    placed, notes = constraint_forces(model)
     lines: list[Line] = []
     drawn = []
     for b in model.bodies:
@@ -52,19 +434,15 @@ def free_body_diagram(model: Model, work: Work) -> Step:
                     ],
                 }
             )
-        drawn.append({"body": b.name, "kind": b.kind, "forces": forces})
-    constraints = []
-    for i, b in enumerate(model.bodies):
-        moves = [qi for qi in model.q if b.position.diff(qi, model.N) != Vector(0)]
-        free = 3 if b.kind == "particle" else 6
-        names = ", ".join(to_latex(qi) for qi in moves) or "nothing"
-        constraints.append(
-            f"{b.name}: the constraint forces on it are perpendicular to every "
-            f"∂r/∂q_j (it moves only with ${names}$), so they do no virtual work"
-            if moves
-            else f"{b.name}: held fixed by its constraints"
+        drawn.append(
+            {
+                "body": b.name,
+                "kind": b.kind,
+                "forces": forces,
+                "free_directions": 3 if b.kind == "particle" else 6,
+                "constraint_forces": placed[b.name],
+            }
         )
-        drawn[i]["free_directions"] = free
     for name, info in model.frames.items():
         w = info.frame.ang_vel_in(model.N)
         lines.append(
@@ -76,14 +454,16 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     if model.springs:
         datum += " and every spring at its rest length"
     text = (
-        "Draw every force on every body. Weights, springs and potentials are conservative and "
-        "enter through V; dampers and applied forces do non-conservative work and enter through "
-        f"Q_j. Constraint forces do no virtual work (notes eq. 18). Datum: {datum}."
+        "Draw every force on every body, the constraint forces where they act. Weights, springs "
+        "and potentials are conservative and enter through V; dampers and applied forces do "
+        "non-conservative work and enter through Q_j. For ideal constraints the constraint "
+        "forces on all bodies together do no virtual work (notes eq. 18–20); on one body alone "
+        f"only when its constraints are its own. Datum: {datum}."
     )
     return Step(
         "fbd",
         "Free-body diagram",
         text,
         lines,
-        {"bodies": drawn, "constraints": constraints, "datum": datum},
+        {"bodies": drawn, "constraints": notes, "datum": datum},
     )

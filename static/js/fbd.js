@@ -1,6 +1,8 @@
 // The free-body diagram at the current instant: the scene drawn faintly, and on every body each
 // force of the run (`forces` of /simulate: weight, spring, damper, applied) as a labelled arrow to
-// scale, plus the constraint forces (dashed) the rods, tracks and hoops supply.
+// scale, plus the constraint forces (dashed), named and placed as the derivation's FBD step says
+// (`constraint_forces` of its data: a rod's tension T, a normal force N, static friction f_s at a
+// rolling contact, a pin reaction R at the pin), sized by Newton's R = m a − ΣF of the run.
 import { SceneGeometry } from "./geometry.js";
 import { toSVG } from "./render.js";
 import { placeLabel, sceneShapes } from "./shapes.js";
@@ -20,8 +22,9 @@ export function labelParts(latex) {
   return { text: (m[1] || m[2] || "").replace(/[\\{}]/g, ""), sub: (m[3] || "").replace(/[\\{}]/g, "") };
 }
 
-/** Draw into `svg` for sample i; `angles` are the stage's 3-D yaw and pitch. */
-export function drawFBD(svg, spec, result, parameters, i, angles = {}) {
+/** Draw into `svg` for sample i; `angles` are the stage's 3-D yaw and pitch; `placed` is the
+ * data of the derivation's FBD step (where each constraint force acts and what it is called). */
+export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = null) {
   if (!svg || !result) return;
   let geom = analysed.get(result);
   if (!geom || geom.spec !== spec) {
@@ -40,7 +43,7 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}) {
   if (geom.is3D) Object.assign(view, { yaw: angles.yaw ?? view.yaw, pitch: angles.pitch ?? view.pitch });
   view.fit(geom.extent([i]), 78);
   const shapes = sceneShapes(geom, view, i, { radius: 8, muted: true, labels: false, axes: false });
-  const arrows = forcesAt(result, i);
+  const arrows = forcesAt(result, i, placed, parameters);
   arrows.push(...potentialForces(spec, result, parameters, i, arrows));
   const kinds = new Set();
   const biggest = Math.max(...arrows.map((a) => a.size), 1e-12);
@@ -53,7 +56,7 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}) {
   }
   for (const f of arrows) {
     if (f.size < 1e-9 * biggest || !result.positions[f.on]) continue;
-    const p = geom.at(f.on, i);
+    const p = f.at || geom.at(f.on, i);
     const [x, y] = view.project(p);
     const color = FORCE_COLORS[f.kind] || FORCE_COLORS.force;
     kinds.add(f.kind);
@@ -63,14 +66,15 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}) {
       const d = view.direction(p, [f.x / f.size, f.y / f.size, f.z / f.size]);
       if (!d[0] && !d[1]) continue;
       const len = 22 + 50 * (f.size / biggest);
-      const alike = drawn.filter(([on, e]) => on === f.on && e[0] * d[0] + e[1] * d[1] > 0.94).length;
-      drawn.push([f.on, d]);
+      const where = String(p.map((v) => v.toFixed(6)));
+      const alike = drawn.filter(([at, e]) => at === where && e[0] * d[0] + e[1] * d[1] > 0.94).length;
+      drawn.push([where, d]);
       const side = alike ? (alike % 2 ? 1 : -1) * 8 * Math.ceil(alike / 2) : 0;
       const foot = [x - d[1] * side, y + d[0] * side];
       const tip = [foot[0] + d[0] * len, foot[1] + d[1] * len];
       shapes.push({ t: "arrow", a: foot, b: tip, color, width: 2.5, head: 10, dash: f.dashed ? [5, 3] : undefined });
-      const { text, sub } = labelParts(f.label);
-      const key = `${text}_${sub}`;
+      const { text, sub } = f.symbol ? { text: f.symbol[0], sub: f.symbol[1] } : labelParts(f.label);
+      const key = `${text}_${sub}@${f.on}`;
       if (used.has(key)) continue;
       used.add(key);
       const before = shapes.length;
@@ -87,20 +91,140 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}) {
   svg.innerHTML = toSVG(shapes);
   svg.dataset.frame = String(i);
   svg.dataset.arrows = String(arrows.filter((a) => a.size >= 1e-9 * biggest).length);
+  const named = arrows.filter((a) => a.kind === "constraint" && a.size >= 1e-9 * biggest);
+  svg.dataset.constraints = JSON.stringify(named.map(({ name, on, at, x, y, z, what }) =>
+    ({ name, on, what, at: at || geom.at(on, i), centre: geom.at(on, i), force: [x, y, z] })));
+  kinds.constraints = [...new Set(named.map((a) => a.name))];
   return kinds;
 }
 
-function forcesAt(result, i) {
+function forcesAt(result, i, placed, parameters) {
   const out = (result.forces || []).map((f) => {
     const x = f.x[i], y = f.y[i], z = f.z[i];
     return { label: f.label, kind: f.kind, on: f.on, x, y, z, size: f.kind === "torque" ? 0 : Math.hypot(x, y, z) };
   });
-  for (const [on, r] of Object.entries(result.constraint_forces || {})) {
-    const x = r.x[i], y = r.y[i], z = r.z[i];
-    const rod = r.tension !== undefined;
-    out.push({ label: rod ? `T_{${on}}` : `R_{${on}}`, kind: "constraint", on, x, y, z, size: Math.hypot(x, y, z), dashed: true });
+  return out.concat(constraintForcesAt(result, i, placed, parameters));
+}
+
+/** The constraint forces at sample i, each where it acts. Newton's R = m a − ΣF of a body is
+ * the sum of its constraint forces; the FBD step says how it splits: the pulls of the rods that
+ * hang from the body, then the rest (a rod's tension toward its anchor, a normal force, at a
+ * rolling contact N across the surface and f_s along it). Without that data (an old derivation)
+ * R is drawn whole at the body, named only as a resultant. */
+export function constraintForcesAt(result, i, placed, parameters = {}) {
+  const R = result.constraint_forces || {};
+  const total = (on) => (R[on] ? [R[on].x[i], R[on].y[i], R[on].z[i]] : null);
+  const entries = (placed?.bodies || []).flatMap((b) => b.constraint_forces || []);
+  if (!placed?.bodies?.some((b) => b.constraint_forces)) {
+    return Object.keys(R).map((on) => arrow({ name: "R", symbol: ["R", on], on,
+      what: `resultant of the constraint forces on ${on}` }, total(on)));
+  }
+  const vars = { ...parameters, t: result.t[i] };
+  for (const [q, v] of Object.entries(result.q || {})) vars[q] = v[i];
+  for (const [q, v] of Object.entries(result.q_dot || {})) vars[`${q}_dot`] = v[i];
+  const place = (name) => {
+    const p = result.positions[name];
+    return p ? [p.x[i], p.y[i], p.z[i]] : null;
+  };
+  const at = (e) => (typeof e.at === "string" ? place(e.at) : e.at.map((c) => evalPlain(c, vars)));
+  const toward = (from, to) => unit(sub3(place(to), place(from)));
+  const tension = (rodBody) => { // the rod's own tension, read off the body at its far end
+    const own = entries.find((e) => e.on === rodBody && e.part === "rest" && e.toward);
+    return own ? dot3(rest(rodBody), toward(rodBody, own.toward)) : NaN;
+  };
+  const pull = (e) => scale3(toward(e.on, e.rod), tension(e.rod));
+  const rest = (on) => entries.filter((e) => e.on === on && e.part === "pull")
+    .reduce((r, e) => sub3(r, pull(e)), total(on));
+  const out = [];
+  for (const e of entries) {
+    if (!total(e.on)) continue;
+    let v;
+    if (e.part === "pull") v = pull(e);
+    else {
+      v = rest(e.on);
+      const u = e.along ? e.along.map((c) => evalPlain(c, vars)) : e.toward ? toward(e.on, e.toward) : null;
+      if (u) v = scale3(u, dot3(v, u));
+    }
+    if (v.every(Number.isFinite)) out.push(arrow(e, v, at(e)));
   }
   return out;
+}
+
+function arrow(e, [x, y, z], at = null) {
+  return { label: e.label || "", symbol: e.symbol, name: e.name, what: e.what, kind: "constraint", on: e.on,
+    at: at && at.every(Number.isFinite) ? at : null, x, y, z, size: Math.hypot(x, y, z), dashed: true };
+}
+
+const sub3 = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const dot3 = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const scale3 = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const unit = (a) => scale3(a, 1 / (Math.hypot(...a) || 1));
+
+const FUNCS = { sin: Math.sin, cos: Math.cos, tan: Math.tan, asin: Math.asin, acos: Math.acos,
+  atan: Math.atan, atan2: Math.atan2, sinh: Math.sinh, cosh: Math.cosh, tanh: Math.tanh,
+  sqrt: Math.sqrt, exp: Math.exp, log: Math.log, Abs: Math.abs, sign: Math.sign,
+  cot: (x) => 1 / Math.tan(x), sec: (x) => 1 / Math.cos(x), csc: (x) => 1 / Math.sin(x) };
+const CONSTS = { pi: Math.PI, E: Math.E };
+const compiled = new Map();
+
+/** The value of a plain-text expression as the engine prints it (`x*cos(alpha) + R**2/2`):
+ * numbers, names from `vars`, + − * / ** ^, parentheses and the usual functions; NaN otherwise. */
+export function evalPlain(src, vars) {
+  if (!compiled.has(src)) compiled.set(src, compile(String(src)));
+  const fn = compiled.get(src);
+  return fn ? fn(vars) : NaN;
+}
+
+function compile(src) {
+  const toks = src.match(/\d+\.?\d*(?:[eE][-+]?\d+)?|\.\d+(?:[eE][-+]?\d+)?|[A-Za-z_]\w*|\*\*|[-+*/^(),]|\S/g) || [];
+  let k = 0;
+  const fail = () => { throw new Error(`cannot read ${src}`); };
+  const eat = (t) => (toks[k] === t ? (k++, true) : false);
+  const sum = () => {
+    let f = product();
+    for (;;) {
+      if (eat("+")) { const a = f, b = product(); f = (v) => a(v) + b(v); }
+      else if (eat("-")) { const a = f, b = product(); f = (v) => a(v) - b(v); }
+      else return f;
+    }
+  };
+  const product = () => {
+    let f = unary();
+    for (;;) {
+      if (eat("*")) { const a = f, b = unary(); f = (v) => a(v) * b(v); }
+      else if (eat("/")) { const a = f, b = unary(); f = (v) => a(v) / b(v); }
+      else return f;
+    }
+  };
+  const unary = () => {
+    if (eat("-")) { const a = unary(); return (v) => -a(v); }
+    if (eat("+")) return unary();
+    const base = atom();
+    if (eat("**") || eat("^")) { const e = unary(); return (v) => base(v) ** e(v); }
+    return base;
+  };
+  const atom = () => {
+    const t = toks[k++];
+    if (t === undefined) fail();
+    if (t === "(") { const f = sum(); if (!eat(")")) fail(); return f; }
+    if (/^[\d.]/.test(t)) { const x = Number(t); return () => x; }
+    if (!/^[A-Za-z_]/.test(t)) fail();
+    if (eat("(")) {
+      const fn = FUNCS[t] || fail();
+      const args = [sum()];
+      while (eat(",")) args.push(sum());
+      if (!eat(")")) fail();
+      return (v) => fn(...args.map((a) => a(v)));
+    }
+    if (t in CONSTS) return () => CONSTS[t];
+    return (v) => (t in v ? v[t] : NaN);
+  };
+  try {
+    const f = sum();
+    return k === toks.length ? f : null;
+  } catch {
+    return null;
+  }
 }
 
 /** The force of the scene's potentials on each particle, read off the motion itself:
@@ -141,11 +265,15 @@ function torqueArc([x, y], sign, color) {
     { t: "arrow", a: prev, b: end, color, width: 2.2, head: 8 }];
 }
 
+const CONSTRAINT_NAMES = { T: "T tension of a rod or rope", N: "N normal force", f_s: "f_s static friction",
+  R: "R pin reaction or resultant" };
+
 /** The legend under the diagram: one swatch per kind of force drawn. */
 export function fbdLegend(box, kinds) {
+  const named = (kinds.constraints || []).map((n) => CONSTRAINT_NAMES[n] || n).join(", ");
   const names = { weight: "weight", spring: "spring", damper: "damper", force: "applied force", torque: "applied torque",
-    constraint: "constraint force (rod tension T, reaction R)", potential: "force of a potential V" };
-  const key = [...kinds].sort().join();
+    constraint: `constraint force, dashed${named ? ` (${named})` : ""}`, potential: "force of a potential V" };
+  const key = [...kinds].sort().join() + named;
   if (box.dataset.kinds === key) return;
   box.dataset.kinds = key;
   box.replaceChildren(...Object.keys(names).filter((k) => kinds.has(k)).map((k) => {

@@ -151,6 +151,7 @@ class SceneView {
       const last = Object.values(a.q).map((v) => v[v.length - 1]);
       $("canvas").dataset.lastQ = JSON.stringify(last);
       $("canvas").dataset.run = String(id);
+      showStop([a, b]);
       this.#plot();
       this.fbd(true);
     } catch (err) {
@@ -195,6 +196,8 @@ class SceneView {
   }
 
   togglePlay() {
+    const r = this.result;
+    if (!this.playing && r && stopOf(r) && this.time >= r.t[r.t.length - 1]) this.time = 0; // replay
     this.#setPlaying(!this.playing);
   }
 
@@ -212,7 +215,10 @@ class SceneView {
       if (r && r.t.length) {
         const end = r.t[r.t.length - 1];
         if (this.playing) this.time += dt * this.speed;
-        if (this.time > end) this.time = end > 0 ? this.time % end : 0;
+        if (this.time >= end && stopOf(r)) { // a stop ended the run: hold its last frame
+          this.time = end;
+          if (this.playing) { this.#setPlaying(false); $("scrub").value = 1000; }
+        } else if (this.time > end) this.time = end > 0 ? this.time % end : 0;
         this.stageA.draw(this.frameIndex());
         if (this.resultB) this.stageB.draw(this.frameIndex(this.resultB));
         $("clock").textContent = `t = ${this.time.toFixed(2)} s`;
@@ -230,8 +236,9 @@ class SceneView {
     if (!now && t - (this.fbdAt || 0) < 150) return;
     this.fbdAt = t;
     if (!this.result || !$("fbd-svg")) return;
+    const placed = this.derivation?.steps?.find((s) => s.id === "fbd")?.data;
     const kinds = drawFBD($("fbd-svg"), this.spec, this.result, this.params, this.frameIndex(),
-      { yaw: this.stageA.yaw, pitch: this.stageA.pitch });
+      { yaw: this.stageA.yaw, pitch: this.stageA.pitch }, placed);
     fbdLegend($("fbd-legend"), kinds);
   }
 
@@ -270,6 +277,26 @@ class SceneView {
     this.time = 0;
     this.schedule(0);
   }
+}
+
+/** `stats.stop` of a run a declared stop condition ended: {name, t, message}. */
+function stopOf(run) {
+  return run?.stats?.stop || null;
+}
+
+/** The banner by the animation when a stop condition ended a run (A, and B in compare mode). */
+function showStop(runs) {
+  const box = $("stop-banner");
+  const lines = runs.filter(Boolean).map((r, k) => {
+    const stop = stopOf(r);
+    if (!stop) return null;
+    const who = runs.filter(Boolean).length > 1 ? `${"AB"[k]}: ` : "";
+    return `${who}Stopped at t = ${Number(stop.t).toFixed(2)} s: ${stop.message}`;
+  }).filter(Boolean);
+  box.textContent = lines.join(" · ");
+  box.hidden = !lines.length;
+  if (lines.length) $("canvas").dataset.stopped = String(stopOf(runs[0])?.t ?? "");
+  else delete $("canvas").dataset.stopped;
 }
 
 function showWarningsBelow(list) {

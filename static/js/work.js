@@ -1,5 +1,7 @@
 // Work and energy between two times (notes II.B, III): each force's W_1→2, ΔT, ΔV and the check
-// W^NC = ΔT + ΔV, as a table and a stacked plot; and the constraint forces along the run — the
+// W^NC = ΔT + ΔV — with, for a driven system (a spinning hoop, a moving support, a time-dependent
+// potential), the work of the drive W_drive (`energy.W_drive` and `stats.driven` of /simulate):
+// W^NC + W_drive = ΔT + ΔV — as a table and a stacked plot; and the constraint forces along the run — the
 // result Newton's method gives and Lagrange's hides (a pendulum's tension, where a string would
 // go slack).
 
@@ -42,11 +44,21 @@ export function showWork(run, { lecture = false } = {}) {
   html.push(`<tr class="sum"><td>ΔT</td><td></td><td>${fmt(dT)}</td></tr>`);
   html.push(`<tr class="sum"><td>ΔV = −W<sup>C</sup></td><td></td><td>${fmt(dV)}</td></tr>`);
   html.push(`<tr class="sum"><td>W<sup>NC</sup></td><td></td><td>${fmt(wnc)}</td></tr>`);
-  const gap = wnc - (dT + dV);
-  const scale = Math.max(Math.abs(dT), Math.abs(dV), Math.abs(wnc), 1e-300);
-  html.push(`<tr class="check"><td>W<sup>NC</sup> − (ΔT + ΔV)</td><td>${Math.abs(gap) <= 1e-5 * scale ? "✔ balanced" : "✘"}</td><td>${fmt(gap)}</td></tr>`);
-  $("work-table").innerHTML = html.join("");
-  $("work-table").dataset.gap = String(gap / scale);
+  const driven = Boolean(run.stats?.driven) && Array.isArray(e.W_drive);
+  const wdrive = driven ? e.W_drive[j] - e.W_drive[i] : 0;
+  if (driven) html.push(`<tr class="sum drive"><td>W<sub>drive</sub>: work of the drive</td><td>driving agent</td><td>${fmt(wdrive)}</td></tr>`);
+  const gap = wnc + wdrive - (dT + dV);
+  const scale = Math.max(Math.abs(dT), Math.abs(dV), Math.abs(wnc), Math.abs(wdrive), 1e-300);
+  const ok = Math.abs(gap) <= 1e-5 * scale;
+  const lhs = driven ? "W<sup>NC</sup> + W<sub>drive</sub>" : "W<sup>NC</sup>";
+  const verdict = ok ? "✔ balanced"
+    : `✘ not balanced: ${lhs} ≠ ΔT + ΔV${driven ? "" : " (work missing from the table?)"}`;
+  html.push(`<tr class="check ${ok ? "pass" : "fail"}"><td>${lhs} − (ΔT + ΔV)</td><td>${verdict}</td><td>${fmt(gap)}</td></tr>`);
+  const table = $("work-table");
+  table.innerHTML = html.join("");
+  table.dataset.gap = String(gap / scale);
+  table.dataset.balanced = ok ? "1" : "0";
+  table.dataset.driven = driven ? "1" : "0";
   if (typeof window.Plotly === "undefined") return;
   const ink = lecture ? "#f1f3f5" : "#1d2430";
   const base = { margin: { l: 60, r: 12, t: 40, b: 46 }, paper_bgcolor: "rgba(0,0,0,0)",
@@ -55,9 +67,10 @@ export function showWork(run, { lecture = false } = {}) {
   const span = t.slice(i, j + 1);
   const traces = Object.entries(run.work.non_conservative).map(([k, w]) => ({
     x: span, y: w.slice(i, j + 1).map((v) => v - w[i]), name: `W ${label(k)}`, stackgroup: "nc", mode: "none" }));
+  if (driven) traces.push({ x: span, y: e.W_drive.slice(i, j + 1).map((v) => v - e.W_drive[i]), name: "W drive", stackgroup: "nc", mode: "none" });
   traces.push({ x: span, y: span.map((_, k) => e.T[i + k] - e.T[i] + e.V[i + k] - e.V[i]), name: "ΔT + ΔV",
     mode: "lines", line: { color: ink, width: 2, dash: "dot" } });
-  window.Plotly.react("plot-work", traces, { ...base, title: { text: "W of each non-conservative force (stacked) and ΔT + ΔV" },
+  window.Plotly.react("plot-work", traces, { ...base, title: { text: driven ? "W of each non-conservative force and of the drive (stacked), and ΔT + ΔV" : "W of each non-conservative force (stacked) and ΔT + ΔV" },
     xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "J" } } }, CONFIG);
   const forces = run.constraint_forces || {};
   const ctraces = Object.entries(forces).map(([body, f]) => f.tension
