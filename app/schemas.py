@@ -200,6 +200,14 @@ class MethodOut(BaseModel):
     note: str = Field(default="", description="Why it is not available, and what runs instead.")
 
 
+class StopOut(BaseModel):
+    """Where a run ended because its model stops holding there."""
+
+    name: str
+    t: float = Field(description="When, located by event detection to the run's tolerance.")
+    message: str
+
+
 class SimulateStats(BaseModel):
     """What the run cost and how accurate it was."""
 
@@ -212,6 +220,16 @@ class SimulateStats(BaseModel):
     wall_time: float = Field(description="Seconds spent integrating.")
     samples: int
     status: str = Field(description="ok, or stopped (see warnings).")
+    driven: bool = Field(
+        default=False,
+        description="True when something drives the system (moving constraints, a spinning "
+        "frame, a time-dependent potential): its work is energy.W_drive.",
+    )
+    stop: StopOut | None = Field(
+        default=None,
+        description="The stop condition that ended the run (the spec's `stops`, a spring "
+        "reaching its anchor, a positive coordinate reaching 0), located to the run's tolerance.",
+    )
     energy_error: float | None = Field(
         default=None, description="max |E(t) - E0| / max |T(t)|, when energy is conserved."
     )
@@ -219,7 +237,9 @@ class SimulateStats(BaseModel):
         default=None, description="The same for the Jacobi integral (moving constraints)."
     )
     energy_balance_error: float | None = Field(
-        default=None, description="max |E(t) - E0 - W_NC(t)| / max |T(t)|, when forces do work."
+        default=None,
+        description="max |E(t) − E0 − W_NC(t) − W_drive(t)| / max |T(t)|, when forces or "
+        "drives do work.",
     )
     momentum_drift: dict[str, float] = Field(
         description="Relative drift of each conserved momentum p_j."
@@ -232,7 +252,11 @@ class SimulateResponse(BaseModel):
     t: list[float]
     q: dict[str, list[float]]
     q_dot: dict[str, list[float]]
-    energy: dict[str, list[float]] = Field(description="T, V, E and W_nc along the run.")
+    energy: dict[str, list[float]] = Field(
+        description="T, V, E, W_nc (work of the non-conservative forces since t = 0) and "
+        "W_drive (work of whatever drives the constraints or the potential in time: "
+        "ΔT + ΔV = W_nc + W_drive) along the run."
+    )
     positions: dict[str, dict[str, list[float]]] = Field(
         description="x, y, z in N of every body and point, for drawing."
     )

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mechanics import cache
+from mechanics.degenerate import check_mass_matrix
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model, build_model
 from mechanics.scenes import load_scene
@@ -29,7 +30,7 @@ from mechanics.steps.lagrange import lagrange_equations
 from mechanics.steps.matrix_form import mass_matrix_form
 
 #: Bump when the derivation's output changes, so stale on-disk entries are never served.
-ENGINE_VERSION = "1"
+ENGINE_VERSION = "2"
 
 STEPS = (
     free_body_diagram,
@@ -94,10 +95,14 @@ class Derivation:
         }
 
 
-def derive_model(spec: SceneSpec | dict) -> Derivation:
-    """Build the model and run every step; raises SpecError/ExprError for bad input."""
+def derive_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) -> Derivation:
+    """Build the model and run every step; raises SpecError/ExprError for bad input.
+
+    ``branches`` picks the side of its anchor each spring along a line is derived on (see
+    `build_model`); simulations of a state on the other side ask for that variant.
+    """
     start = time.perf_counter()
-    model = build_model(spec)
+    model = build_model(spec, branches)
     work = Work(started=start)
     token = unsimplified.set([])
     try:
@@ -109,7 +114,9 @@ def derive_model(spec: SceneSpec | dict) -> Derivation:
             )
     finally:
         unsimplified.reset(token)
-    return Derivation(model, work, steps, time.perf_counter() - start)
+    derivation = Derivation(model, work, steps, time.perf_counter() - start)
+    check_mass_matrix(derivation)
+    return derivation
 
 
 def derive(spec: SceneSpec | dict) -> dict[str, Any]:
@@ -118,9 +125,9 @@ def derive(spec: SceneSpec | dict) -> dict[str, Any]:
 
 
 @functools.lru_cache(maxsize=64)
-def derivation_of_scene(scene_id: str) -> Derivation:
-    """The sympy-level derivation of a built-in scene, once per process."""
-    return derive_model(parse_spec(load_scene(scene_id)))
+def derivation_of_scene(scene_id: str, branches: tuple[tuple[int, int], ...] = ()) -> Derivation:
+    """The sympy-level derivation of a built-in scene, once per process (and branch variant)."""
+    return derive_model(parse_spec(load_scene(scene_id)), dict(branches) or None)
 
 
 _memory: dict[str, dict[str, Any]] = {}

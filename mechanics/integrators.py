@@ -127,6 +127,11 @@ class _Counted:
         self.watch = self.fortran = False
         self.bad_t: float | None = None
         self.failure: BaseException | None = None
+        self.stop_watch: Callable[[float, np.ndarray], bool] | None = None
+
+    def watched(self, t: float, y: np.ndarray) -> bool:
+        """Has a stop condition been reached at this step's end?"""
+        return self.stop_watch is not None and bool(self.stop_watch(t, y))
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         self.calls += 1
@@ -170,6 +175,7 @@ def integrate(
     max_steps: int = 5_000_000,
     second_order: int | None = None,
     native: NativeRhs | None = None,
+    watch: Callable[[float, np.ndarray], bool] | None = None,
 ) -> Trajectory:
     """Integrate dy/dt = rhs(t, y) from y0 and sample it at t_eval (increasing, from t0).
 
@@ -184,6 +190,10 @@ def integrate(
     function as ``rhs``) no Python runs per step; without it ``rhs`` is called back from C.
     Where no C compiler is available it runs scipy's DOP853 instead (the same steps) and says
     so in ``note``.
+
+    ``watch(t, y)`` is asked after every step the Python paths take; True ends the run there
+    (status "stopped"): the model stops holding (a stop condition), and stepping on would only
+    chatter at a discontinuity. The caller locates the exact moment. The C loop is not watched.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
@@ -207,6 +217,7 @@ def integrate(
         return Trajectory(t_eval.copy(), y0[None, :].copy(), "ok", "", 0, 0, 0, 0.0)
 
     f, run = _Counted(rhs, max_wall_time, start), _Run(y0)
+    f.stop_watch = watch
     status, message, note = "ok", "", ""
     if method == "dop853_c":
         why = native_code.available()
@@ -296,6 +307,8 @@ def _fixed(run: _Run, step, f: _Counted, t_eval, dt, max_steps, n) -> None:
             run.nsteps += 1
             if not _finite(y):
                 raise _Stop(f"state became non-finite at t = {t0 + (i + 1) * h:.6g} s")
+            if f.watched(t0 + (i + 1) * h, y):
+                raise _Stop(f"a stop condition was reached near t = {t0 + (i + 1) * h:.6g} s")
         run.out.append(y)
 
 
@@ -342,6 +355,8 @@ def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) ->
                     raise _Stop(f"state became non-finite at t = {t_eval[k]:.6g} s")
                 run.out.append(y)
                 k += 1
+        if f.watched(solver.t, solver.y):
+            raise _Stop(f"a stop condition was reached near t = {solver.t:.6g} s")
 
 
 _DOP853_CODES = {
@@ -358,6 +373,8 @@ def _fortran(run: _Run, f: _Counted, y0, t_eval, rtol, atol, max_steps) -> None:
     f.watch = f.fortran = True
 
     def solout(t: float, y: np.ndarray) -> int:
+        if f.failure is None and f.watched(t, y):
+            f.failure = _Stop(f"a stop condition was reached near t = {t:.6g} s")
         return -1 if f.failure is not None or not _finite(y) else 0
 
     solver = si.ode(f).set_integrator("dop853", rtol=rtol, atol=atol, nsteps=max_steps)

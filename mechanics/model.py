@@ -15,7 +15,7 @@ from sympy.physics.mechanics import Particle, RigidBody, inertia
 from sympy.physics.vector import Point, ReferenceFrame, Vector, dynamicsymbols
 
 from mechanics.expr import parse
-from mechanics.spec import FramePosition, SceneSpec, parse_spec
+from mechanics.spec import FramePosition, SceneSpec, nonnegative_parameters, parse_spec
 
 T = dynamicsymbols._t
 
@@ -67,6 +67,24 @@ class SpringInfo:
     rest_length: sp.Expr
     length: sp.Expr
     energy: sp.Expr
+    #: ℓ written without |·| on one side of the anchor (`length` = `branch` there, valid while it
+    #: is > 0); None when ℓ needs no branch (ℓ₀ = 0, a sign fixed by assumptions, or ℓ = √(d·d)).
+    branch: sp.Expr | None = None
+    sign: int = 0  # which side: ℓ = sign · p for the perfect square d·d = p²
+
+
+@dataclass
+class StopInfo:
+    """A condition past which the model does not hold (see `mechanics.spec.Stop`): the run ends
+    where `when` (or the named body's tension) reaches 0."""
+
+    name: str
+    message: str
+    when: sp.Expr | None = None
+    tension: str | None = None
+    crossing: str = "falls"
+    only_if: sp.Expr | None = None
+    along: tuple[float, float, float] | None = None  # unit vector in N: the string's direction
 
 
 @dataclass
@@ -88,6 +106,11 @@ class Model:
     springs: list[SpringInfo] = field(default_factory=list)
     loads: list[Load] = field(default_factory=list)
     potentials: list[tuple[str, sp.Expr]] = field(default_factory=list)
+    #: The sides of its anchor each branched spring was derived for ({index: ±1}).
+    branches: dict[int, int] = field(default_factory=dict)
+    #: Declared stops, then the implicit ones: a branched spring reaching its anchor, a positive
+    #: coordinate reaching 0.
+    stops: list[StopInfo] = field(default_factory=list)
 
     @property
     def coordinate_names(self) -> list[str]:
@@ -106,17 +129,21 @@ class Model:
 def symbols_for(spec: SceneSpec) -> tuple[list, dict[str, sp.Symbol], dict[str, sp.Expr]]:
     """Coordinates as functions of t, parameters as symbols, and the parser's name table.
 
-    Parameters whose default is positive are declared nonnegative so that sqrt(l**2) prints as l;
-    the simulation refuses negative values for them (a negative mass or length is an input error).
+    Only parameters nonnegative by nature (a mass, a length, a stiffness: `nonnegative_parameters`)
+    are declared nonnegative, so that sqrt(l**2) prints as l; every request refuses negative values
+    for exactly those. Everything else is merely real: a charge or a rotation rate may be negative.
     """
     positive = set(spec.positive_coordinates)
+    magnitudes = nonnegative_parameters(spec)
     q = [
         dynamicsymbols(name, positive=True) if name in positive else dynamicsymbols(name)
         for name in spec.coordinates
     ]
     params = {
-        name: sp.Symbol(name, nonnegative=True) if value > 0 else sp.Symbol(name, real=True)
-        for name, value in spec.parameters.items()
+        name: sp.Symbol(name, nonnegative=True)
+        if name in magnitudes
+        else sp.Symbol(name, real=True)
+        for name in spec.parameters
     }
     names: dict[str, sp.Expr] = {"t": T, **params}
     for name, qi in zip(spec.coordinates, q, strict=True):
@@ -138,8 +165,13 @@ def _frame_latex(name: str, unit_vectors: list[str] | None) -> tuple[list[str], 
     return [rf"\hat{{{low}}}_{{{a}}}" for a in "xyz"], tuple(f"{name}.{a}" for a in "xyz")
 
 
-def build_model(spec: SceneSpec | dict) -> Model:
-    """Turn a validated spec into frames, points and bodies; raises ExprError with field paths."""
+def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) -> Model:
+    """Turn a validated spec into frames, points and bodies; raises ExprError with field paths.
+
+    ``branches`` picks, per spring index, the side of its anchor a spring along a line is on
+    (ℓ = ±p); by default the side of the spec's initial state. A run that starts on the other
+    side is derived with the other sign, so V = ½k(|d| − ℓ₀)² holds for every state.
+    """
     if not isinstance(spec, SceneSpec):
         spec = parse_spec(spec)
     q, params, names = symbols_for(spec)
@@ -258,23 +290,34 @@ def build_model(spec: SceneSpec | dict) -> Model:
         )
 
     springs = []
+    chosen: dict[int, int] = {}
     for i, s in enumerate(spec.springs):
         k = expr(s.k, f"springs[{i}].k")
         l0 = expr(s.rest_length, f"springs[{i}].rest_length")
         d = positions[s.b] - positions[s.a]
-        length = _spring_length(d.dot(d), spec, names)
-        d2 = length**2
-        energy = k * d2 / 2 if l0 == 0 else k * (length - l0) ** 2 / 2
-        springs.append(SpringInfo(s.name or f"spring{i + 1}", s.a, s.b, k, l0, length, energy))
+        name = s.name or f"spring{i + 1}"
+        if l0.is_zero:  # ½ k d·d: smooth everywhere, no length to take a root of
+            length, branch, sign = _length_of(d.dot(d))
+            springs.append(SpringInfo(name, s.a, s.b, k, l0, length, k * d.dot(d) / 2))
+            continue
+        length, branch, sign = _length_of(d.dot(d), (branches or {}).get(i), spec, names)
+        if branch is not None:
+            chosen[i] = sign
+        energy = k * (length - l0) ** 2 / 2
+        springs.append(SpringInfo(name, s.a, s.b, k, l0, length, energy, branch, sign))
 
     loads: list[Load] = []
     for i, dmp in enumerate(spec.dampers):
+        # A dashpot resists only the rate its length changes: F_b = −c ((v_b − v_a)·ê) ê, with
+        # ê d·d = (d·ê) d, so no square root (and no direction to lose at zero length on a line).
         c = expr(dmp.c, f"dampers[{i}].c")
+        d = positions[dmp.b] - positions[dmp.a]
         rel = positions[dmp.b].dt(N) - positions[dmp.a].dt(N)
+        along = -c * rel.dot(d) / _tidy_square(d.dot(d)) * d
         name = dmp.name or f"damper{i + 1}"
-        loads.append(Load(name, "damper", dmp.b, -c * rel))
+        loads.append(Load(name, "damper", dmp.b, along))
         if dmp.a != "O":
-            loads.append(Load(name, "damper", dmp.a, c * rel))
+            loads.append(Load(name, "damper", dmp.a, -along))
     for group, kind, items in (
         ("forces", "force", spec.forces),
         ("torques", "torque", spec.torques),
@@ -287,6 +330,40 @@ def build_model(spec: SceneSpec | dict) -> Model:
         (p.name, expr(p.expression, f"potentials[{i}].expression"))
         for i, p in enumerate(spec.potentials)
     ]
+    stops = [
+        StopInfo(
+            st.name,
+            st.message,
+            None if st.when is None else expr(st.when, f"stops[{i}].when", allow_velocity=True),
+            st.tension,
+            st.crossing,
+            None
+            if st.only_if is None
+            else expr(st.only_if, f"stops[{i}].only_if", allow_velocity=True),
+            _unit(st.along),
+        )
+        for i, st in enumerate(spec.stops)
+    ]
+    for s in springs:
+        if s.branch is not None:
+            stops.append(
+                StopInfo(
+                    f"{s.name}_at_anchor",
+                    f"the spring {s.name} reaches zero length: its direction is undefined "
+                    "there (V = ½k(|d| − ℓ₀)² has a corner), so the model ends",
+                    s.branch,
+                )
+            )
+    for name, qi in zip(spec.coordinates, q, strict=True):
+        if name in spec.positive_coordinates:
+            stops.append(
+                StopInfo(
+                    f"{name}_at_zero",
+                    f"{name} reaches 0, where the coordinates are singular "
+                    f"({name} is declared positive)",
+                    qi,
+                )
+            )
     return Model(
         spec=spec,
         q=q,
@@ -305,31 +382,70 @@ def build_model(spec: SceneSpec | dict) -> Model:
         springs=springs,
         loads=loads,
         potentials=potentials,
+        branches=chosen,
+        stops=stops,
     )
+
+
+def _unit(v: list[float] | None) -> tuple[float, float, float] | None:
+    if v is None:
+        return None
+    v = [*v, 0.0][:3]
+    norm = sum(c * c for c in v) ** 0.5
+    return (v[0] / norm, v[1] / norm, v[2] / norm)
 
 
 class _Unresolved(Exception):
     pass
 
 
-def _spring_length(d2: sp.Expr, spec: SceneSpec, names: dict[str, sp.Expr]) -> sp.Expr:
-    """ℓ = |d| as a textbook prints it.
+def _tidy_square(d2: sp.Expr) -> sp.Expr:
+    return sp.factor(sp.trigsimp(sp.expand(d2)))
 
-    When |d|² is a perfect square p² (every spring along a line), ℓ = ±p with the sign it has in
-    the scene's initial state: a spring cannot pass through zero length, so that sign holds for
-    the whole motion, and V = ½k(ℓ − ℓ₀)² keeps no |·| whose derivative would print sign(·).
+
+def _length_of(
+    d2: sp.Expr,
+    forced: int | None = None,
+    spec: SceneSpec | None = None,
+    names: dict[str, sp.Expr] | None = None,
+) -> tuple[sp.Expr, sp.Expr | None, int]:
+    """ℓ = |d| as a textbook prints it: (ℓ, branch, sign).
+
+    When d·d is a perfect square p² (every spring along a line), ℓ = |p|. A textbook writes ℓ = p
+    or ℓ = −p, whichever is positive, with no |·| whose derivative would print sign(·). Where
+    assumptions fix the sign (p = r > 0) that is exact; otherwise the sign is the side of the
+    reference state (``forced``, else the spec's initial state, else +) and the branch p·sign is
+    returned: the formula holds while it is > 0, and runs check it (start on the other side: the
+    other sign; reach 0: stop).
     """
-    d2 = sp.factor(sp.trigsimp(sp.expand(d2)))
+    d2 = _tidy_square(d2)
     if isinstance(d2, sp.Pow) and d2.exp == 2:
         base = d2.base
     elif d2.is_Mul and all(isinstance(f, sp.Pow) and f.exp == 2 for f in d2.args):
         base = sp.Mul(*(f.base for f in d2.args))
     else:
-        return sp.sqrt(d2)
-    values = {names[k]: v for k, v in spec.parameters.items()}
+        return sp.sqrt(d2), None, 0
+    if base.is_positive:
+        return base, None, 1
+    if base.is_negative:
+        return -base, None, -1
+    if spec is None or names is None:
+        return sp.sqrt(d2), None, 0
+    sign = forced if forced in (1, -1) else _reference_sign(base, spec, names)
+    return sign * base, sign * base, sign
+
+
+def _reference_sign(base: sp.Expr, spec: SceneSpec, names: dict[str, sp.Expr]) -> int:
+    """The sign of p in the spec's own state (parameters, initial values, t = 0); + at p = 0."""
+    values: dict[sp.Expr, sp.Expr] = {names[k]: sp.Float(v) for k, v in spec.parameters.items()}
+    for name in reversed(spec.coordinates):  # velocities before the coordinates inside them
+        values[names[f"{name}_dot"]] = sp.Float(spec.initial.get(f"{name}_dot", 0.0))
     for name in spec.coordinates:
-        values[names[name]] = spec.initial.get(name, 0.0)
-    value = base.subs(values)
-    if value.is_number and value.is_real and value != 0:
-        return base if value > 0 else -base
-    return sp.sqrt(d2)
+        values[names[name]] = sp.Float(spec.initial.get(name, 0.0))
+    values[T] = sp.Integer(0)
+    value = base.xreplace(values)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return 1
+    return -1 if number < 0 else 1

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -20,6 +20,9 @@ from sympy.physics.vector import Vector
 from mechanics import native
 from mechanics.derive import Derivation, derivation_of_scene, derive_model
 from mechanics.model import T as t
+from mechanics.spec import SpecError
+from mechanics.steps import partial
+from mechanics.steps.conserved import explicit_time
 from mechanics.steps.energy import potential_parts
 from mechanics.steps.fbd import body_forces
 
@@ -30,6 +33,17 @@ def _sign(x: float) -> float:
 
 _MATH = [{"sign": _sign, "Abs": abs}, "math"]
 _NUMPY = [{"sign": np.sign, "Abs": np.abs}, "numpy"]
+
+
+@dataclass
+class StopFunction:
+    """A stop condition compiled for arrays and scalars: value(t, q, q̇, p) > 0 while it holds."""
+
+    name: str
+    message: str
+    crossing: str  # "falls" | "any"
+    value: Any
+    only_if: Any | None = None
 
 
 @dataclass
@@ -53,6 +67,14 @@ class CompiledScene:
     frames: dict[str, Any]  # arrays: -> 9 components of the frame's axes in N
     solved: bool  # True: q̈ from the symbolic solution; False: M q̈ = f solved numerically
     native_inputs: dict[str, Any]  # rhs_source's arguments: the same expressions, for C
+    #: Extra states after q, q̇: W_NC, and W_t = ∫ −∂L/∂t dt when L depends on t explicitly.
+    extras: int = 1
+    #: arrays: E − h = T₁ + 2T₀, so the drive's work is W_drive = Δ(E − h) + W_t. None when the
+    #: constraints do not move and L has no explicit t (nothing drives the system).
+    drive: Any | None = None
+    #: arrays: p of each branched spring (ℓ = p on the side it was derived for), by spring index.
+    branch_values: dict[int, Any] = field(default_factory=dict)
+    stop_specs: list[Any] = field(default_factory=list)  # model StopInfo, compiled on first use
 
     @property
     def n(self) -> int:
@@ -65,10 +87,42 @@ class CompiledScene:
 
     def native_rhs(self, params: list[float]) -> native.NativeRhs:
         """The compiled twin of `rhs(params)`; raises NativeUnavailable when it cannot be built."""
-        return native.compile_rhs(self.native_source, params, 2 * self.n + 1)
+        return native.compile_rhs(self.native_source, params, 2 * self.n + self.extras)
+
+    @functools.cached_property
+    def stops(self) -> list[StopFunction]:
+        """The stop conditions as functions (a string's tension needs Newton's method: compiled
+        only for scenes that declare one)."""
+        args, subs = _args(self.derivation)
+        out = []
+        for i, st in enumerate(self.stop_specs):
+            if st.tension is not None and st.along is not None:
+                force = constraint_force_functions(self).get(st.tension, (None, None))[0]
+                value = _along(force, st.along)
+            elif st.tension is not None:
+                fns = constraint_force_functions(self)
+                if fns.get(st.tension, (None, None))[1] is None:
+                    raise SpecError(
+                        [
+                            {
+                                "field": f"stops[{i}].tension",
+                                "message": f"'{st.tension}' hangs on no string or rod whose "
+                                "tension Newton's method can name",
+                            }
+                        ]
+                    )
+                value = fns[st.tension][1]
+            else:
+                value = sp.lambdify(args, [_plain(st.when, subs)], modules=_NUMPY)
+            guard = None
+            if st.only_if is not None:
+                guard = sp.lambdify(args, [_plain(st.only_if, subs)], modules=_NUMPY)
+            out.append(StopFunction(st.name, st.message, st.crossing, value, guard))
+        return out
 
     def rhs(self, params: list[float]):
-        """dy/dt for y = [q, q̇, W_NC]: the work of the non-conservative forces rides along."""
+        """dy/dt for y = [q, q̇, W_NC (, W_t)]: the work of the non-conservative forces (and of
+        the explicit time dependence of L) rides along."""
         n = self.n
         p = tuple(params)
         if self.solved:
@@ -84,13 +138,23 @@ class CompiledScene:
         def rhs(time: float, y: np.ndarray) -> np.ndarray:
             args = (time, *y.tolist()[: 2 * n], *p)
             values = np.asarray(mf(*args), dtype=float)
-            out = np.empty(2 * n + 1)
+            out = np.empty(2 * n + self.extras)
             out[:n] = y[n : 2 * n]
             out[n : 2 * n] = np.linalg.solve(values[: n * n].reshape(n, n), values[n * n :])
-            out[2 * n] = power(*args)
+            out[2 * n :] = power(*args)
             return out
 
         return rhs
+
+
+def _along(force: Any, unit: tuple[float, float, float]) -> Any:
+    """R·ê of a compiled constraint force (x, y, z in N): a string's tension along ê."""
+
+    def value(*args: Any) -> list[Any]:
+        x, y, z = force(*args)
+        return [unit[0] * np.asarray(x) + unit[1] * np.asarray(y) + unit[2] * np.asarray(z)]
+
+    return value
 
 
 def _args(d: Derivation) -> tuple[list, dict]:
@@ -120,18 +184,27 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         return sp.lambdify(args, [_plain(e, subs) for e in exprs], modules=_NUMPY, cse=True)
 
     power = sum((Q * qd for Q, qd in zip(w.Q, m.qd, strict=True)), sp.S.Zero)
+    rates = [power]
+    if explicit_time(w.L, m):
+        rates.append(-partial(w.L, t, m))  # dh/dt = Σ Q_j q̇_j − ∂L/∂t (notes III)
+    # E − h = T₁ + 2T₀ vanishes unless constraints move (T not quadratic in q̇): the drive's work
+    # W_drive = ΔE − W_NC = Δ(E − h) + W_t, since dh/dt = P_NC − ∂L/∂t.
+    h = sum((qd * p for qd, p in zip(m.qd, w.momenta, strict=True)), sp.S.Zero) - w.L
+    drive = sp.expand(w.T + w.V - h)
+    if drive == 0 and len(rates) == 1:
+        drive = None
     solved = w.accelerations is not None
-    native_inputs = {"args": args, "n": len(m.q), "power": _plain(power, subs)}
+    native_inputs = {"args": args, "n": len(m.q), "power": [_plain(r, subs) for r in rates]}
     if solved:
         native_inputs["accelerations"] = [_plain(e, subs) for e in w.accelerations]
     else:
         native_inputs["mass"] = [_plain(e, subs) for e in w.mass_matrix]
         native_inputs["forcing"] = [_plain(e, subs) for e in w.forcing]
     if solved:
-        accel_and_power = scalar([*w.accelerations, power])
+        accel_and_power = scalar([*w.accelerations, *rates])
         mass_and_forcing = None
     else:
-        accel_and_power = sp.lambdify(args, _plain(power, subs), modules=_MATH, cse=True)
+        accel_and_power = scalar(rates)
         mass_and_forcing = scalar([*w.mass_matrix, *w.forcing])
     jacobi = next((c["expr"] for c in w.conserved if c["name"] == "jacobi"), None)
     powers = {}
@@ -180,6 +253,12 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         frames=frames,
         solved=solved,
         native_inputs=native_inputs,
+        extras=len(rates),
+        drive=None if drive is None else vector([drive]),
+        branch_values={
+            i: vector([s.branch]) for i, s in enumerate(m.springs) if s.branch is not None
+        },
+        stop_specs=list(m.stops),
     )
 
 
@@ -205,20 +284,24 @@ def constraint_force_functions(c: CompiledScene) -> dict[str, tuple[Any, Any | N
     return cached
 
 
+Branches = tuple[tuple[int, int], ...]
+
+
 @functools.lru_cache(maxsize=64)
-def compiled_scene(scene_id: str) -> CompiledScene:
-    """A built-in scene compiled once per process; a slider change only changes the arguments."""
-    return compile_derivation(derivation_of_scene(scene_id))
+def compiled_scene(scene_id: str, branches: Branches = ()) -> CompiledScene:
+    """A built-in scene compiled once per process; a slider change only changes the arguments.
+    ``branches`` asks for the variant with springs on other sides of their anchors."""
+    return compile_derivation(derivation_of_scene(scene_id, branches))
 
 
 @functools.lru_cache(maxsize=32)
-def _compiled_spec(spec_json: str) -> CompiledScene:
-    return compile_derivation(derive_model(json.loads(spec_json)))
+def _compiled_spec(spec_json: str, branches: Branches = ()) -> CompiledScene:
+    return compile_derivation(derive_model(json.loads(spec_json), dict(branches) or None))
 
 
-def compiled_spec(spec: dict) -> CompiledScene:
+def compiled_spec(spec: dict, branches: Branches = ()) -> CompiledScene:
     """A posted spec compiled once per distinct spec (keyed by its canonical JSON)."""
-    return _compiled_spec(json.dumps(spec, sort_keys=True))
+    return _compiled_spec(json.dumps(spec, sort_keys=True), branches)
 
 
 def evaluate(fn: Any, time: np.ndarray, q: np.ndarray, qd: np.ndarray, params: list[float]):

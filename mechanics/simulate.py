@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.integrate import cumulative_simpson
+from scipy.integrate import cumulative_simpson, solve_ivp
 
-from mechanics.integrators import METHODS, integrate
+from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
     CompiledScene,
@@ -31,6 +31,8 @@ MAX_T_END = 1000.0
 MAX_SAMPLES = 20_001
 MAX_FPS = 240
 MAX_WALL_TIME = 10.0
+#: Springs along a line whose side of the anchor a request may flip (one re-derivation each).
+MAX_BRANCH_FLIPS = 17
 MAX_FIXED_STEPS = 2_000_000
 #: Above this relative energy error the run carries a warning.
 ENERGY_WARNING = 1e-3
@@ -95,10 +97,84 @@ def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float]
         raise SpecError(errors)
     values = {**spec.parameters, **req.parameters}
     init = {**spec.initial, **req.initial}
+    for q in spec.positive_coordinates:
+        if init.get(q, 0.0) <= 0:
+            errors.append(
+                {"field": f"initial.{q}", "message": f"must be > 0 ({q} is declared positive)"}
+            )
+    if errors:
+        raise SpecError(errors)
     y0 = [init.get(q, 0.0) for q in c.coordinates] + [
         init.get(f"{q}_dot", 0.0) for q in c.coordinates
     ]
-    return [values[k] for k in c.parameters], np.array([*y0, 0.0])
+    params = [values[k] for k in c.parameters]
+    state = np.array([*y0, *[0.0] * c.extras])
+    check_state(c, params, state, req)
+    return params, state
+
+
+def _at(fn: Any, t0: float, y0: np.ndarray, n: int, params: list[float]) -> list[float]:
+    """An array function at one state."""
+    t = np.array([t0])
+    return [float(v[0]) for v in evaluate(fn, t, y0[:n, None], y0[n : 2 * n, None], params)]
+
+
+def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any) -> None:
+    """The state a run starts from must lie where the derived equations hold: every branched
+    spring on the side it was derived for and off its anchor, every declared stop not already
+    passed, and a mass matrix that can be inverted."""
+    n, m = c.n, c.derivation.model
+    errors = []
+    names = ", ".join(f"initial.{q}" for q in c.coordinates if q in req.initial) or "initial"
+    for i, fn in c.branch_values.items():
+        (p,) = _at(fn, 0.0, y0, n, params)
+        spring = m.springs[i]
+        if abs(p) <= 1e-12 * max(1.0, float(np.max(np.abs(y0[:n]), initial=0.0))):
+            errors.append(
+                {
+                    "field": names,
+                    "message": f"the spring {spring.name} has zero length in this state (at its "
+                    "anchor its direction is undefined): start it off the anchor",
+                }
+            )
+        elif p < 0:
+            raise _OtherBranch(i, -spring.sign)
+    mass = np.array(_at(c.mass_matrix, 0.0, y0, n, params)).reshape(n, n)
+    with np.errstate(all="ignore"):
+        eig = np.linalg.eigvalsh((mass + mass.T) / 2) if np.all(np.isfinite(mass)) else [np.nan]
+    if not np.all(np.isfinite(eig)) or min(eig) <= 1e-14 * max(abs(e) for e in eig):
+        errors.append(_singular_mass(c, params, names))
+    if errors:
+        raise SpecError(errors)
+
+
+def _singular_mass(c: CompiledScene, params: list[float], names: str) -> dict[str, str]:
+    """Name the parameters that make M singular (a zero mass), else the state (a pole)."""
+    m = c.derivation.model
+    used = {str(s) for s in c.derivation.work.mass_matrix.free_symbols}
+    culprits = [k for k, v in zip(c.parameters, params, strict=True) if k in used and v <= 0]
+    if culprits:
+        return {
+            "field": ", ".join(f"parameters.{k}" for k in culprits),
+            "message": "must be > 0: with "
+            + ", ".join(
+                f"{k} = {v:g}" for k, v in zip(c.parameters, params, strict=True) if k in culprits
+            )
+            + " the mass matrix is singular (a coordinate has no inertia), so q̈ is undefined",
+        }
+    return {
+        "field": names,
+        "message": "the mass matrix is singular (or not positive definite) in this state: the "
+        f"coordinates {', '.join(m.coordinate_names)} are singular here (like φ at θ = 0 of "
+        "spherical coordinates) or a mass or inertia is not positive; start elsewhere",
+    }
+
+
+class _OtherBranch(Exception):
+    """The state lies on the other side of a spring's anchor: derive that variant."""
+
+    def __init__(self, index: int, sign: int) -> None:
+        self.index, self.sign = index, sign
 
 
 def _run(
@@ -109,27 +185,41 @@ def _run(
     req: SimulationRequest,
     rtol: float,
     atol: float,
-):
-    compiled, why = None, ""
-    if req.method == "dop853_c":
+) -> Trajectory:
+    """One integration; a scene with stops gets a fresh `StopWatch` (``run.watch``).
+
+    The C loop is not watched: its samples are searched afterwards, which finds every smooth
+    stop. A stop where the motion reverses (friction sticking) makes the steps chatter at a
+    discontinuity instead of crossing it, so such scenes step in Python, watched every step.
+    """
+    compiled, why, method = None, "", req.method
+    watch = _watch(c, params, y0)
+    chatter = any(stop.crossing == "any" for stop in c.stops)
+    if method == "dop853_c" and chatter:
+        method = "DOP853"
+        why = "stepped by scipy's DOP853 (the same steps) so a reversal is caught every step"
+    elif method == "dop853_c":
         try:
             compiled = c.native_rhs(params)
         except NativeUnavailable as exc:
             why = str(exc)  # the C loop calls the Python right-hand side back (or scipy runs it)
+            why = f"The equations could not be compiled to C ({why}): the C loop called Python."
     run = integrate(
         c.rhs(params),
         y0,
         t_eval,
-        method=req.method,
+        method=method,
         rtol=rtol,
         atol=atol,
         dt=req.dt,
         max_wall_time=MAX_WALL_TIME,
         second_order=c.n,
         native=compiled,
+        watch=watch,
     )
     if why and not run.note:
-        run.note = f"The equations could not be compiled to C ({why}): the C loop called Python."
+        run.note = why[0].upper() + why[1:] if why.endswith(".") else f"This scene was {why}."
+    run.watch = watch
     return run
 
 
@@ -137,9 +227,15 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     params, y0 = check_request(c, req)
     n_samples = int(math.floor(req.t_end * req.fps + 1e-9)) + 1
     t_eval = np.linspace(0.0, (n_samples - 1) / req.fps, n_samples)
+    refuse_passed_stops(c, params, y0)
     run = _run(c, params, y0, t_eval, req, req.rtol, req.atol)
     warnings: list[str] = [run.note] if run.note else []
-    if run.status != "ok":
+    raw = run
+    stop = first_stop(c, run, params, req, run.watch)
+    if stop is not None:
+        run = stop.run
+        warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
+    elif run.status != "ok":
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
         if "step" in run.message.lower() or "budget" in run.message.lower():
             if not METHODS[req.method].implicit:
@@ -149,6 +245,10 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     q, qd, w_nc = y[:, :n].T, y[:, n : 2 * n].T, y[:, 2 * n]
     T, V = evaluate(c.energy, t, q, qd, params)
     E = T + V
+    w_drive = np.zeros_like(t)
+    if c.drive is not None:
+        (e_minus_h,) = evaluate(c.drive, t, q, qd, params)
+        w_drive = e_minus_h - e_minus_h[0] + (y[:, 2 * n + 1] if c.extras > 1 else 0.0)
     stats: dict[str, Any] = {
         "method": req.method,
         "steps": run.nsteps,
@@ -157,7 +257,10 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         "wall_time": run.wall_time,
         "samples": len(t),
         "status": run.status,
+        "driven": c.drive is not None,
     }
+    if stop is not None:
+        stats["stop"] = {"name": stop.name, "t": stop.t, "message": stop.message}
     scale = max(float(np.max(np.abs(T))) if len(T) else 0.0, 1e-300)
     conserved = {x["name"] for x in c.derivation.work.conserved}
     if "energy" in conserved:
@@ -166,7 +269,8 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         (h,) = evaluate(c.jacobi, t, q, qd, params)
         stats["jacobi_error"] = float(np.max(np.abs(h - h[0]))) / scale
     else:
-        stats["energy_balance_error"] = float(np.max(np.abs(E - E[0] - w_nc))) / scale
+        # ΔT + ΔV = W_NC + W_drive (notes III): every agent that does work is on the right.
+        stats["energy_balance_error"] = float(np.max(np.abs(E - E[0] - w_nc - w_drive))) / scale
     drift = {}
     for name, fn in c.momenta.items():
         (p,) = evaluate(fn, t, q, qd, params)
@@ -179,7 +283,7 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
             "tighten the tolerance or the step, or pick a higher-order method."
         )
     warnings += _singularity_warnings(c, t, q, qd, params)
-    if req.check_sensitivity and METHODS[req.method].kind == "adaptive" and run.status == "ok":
+    if req.check_sensitivity and METHODS[req.method].kind == "adaptive" and raw.status == "ok":
         warnings += _sensitivity(c, params, y0, t_eval, req, run)
     positions = {
         name: dict(zip("xyz", evaluate(fn, t, q, qd, params), strict=True))
@@ -208,12 +312,263 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         "t": t.tolist(),
         "q": {name: q[i].tolist() for i, name in enumerate(c.coordinates)},
         "q_dot": {name: qd[i].tolist() for i, name in enumerate(c.coordinates)},
-        "energy": {"T": T.tolist(), "V": V.tolist(), "E": E.tolist(), "W_nc": w_nc.tolist()},
+        "energy": {
+            "T": T.tolist(),
+            "V": V.tolist(),
+            "E": E.tolist(),
+            "W_nc": w_nc.tolist(),
+            "W_drive": w_drive.tolist(),
+        },
         "positions": {k: {a: v.tolist() for a, v in xyz.items()} for k, xyz in positions.items()},
         "frames": {k: v.tolist() for k, v in frames.items()},
         "stats": stats,
         "warnings": warnings,
     }
+
+
+@dataclass
+class StopEvent:
+    name: str
+    message: str
+    t: float
+    run: Trajectory  # the run cut at the stop, its last sample the located state
+
+
+class StopWatch:
+    """Asked after every step of a Python-stepped run: has a stop been reached since the last
+    step? It remembers where, for `first_stop` to locate the moment.
+
+    A stop counts as reached when its value crosses 0 (falls to 0, or changes sign). A sign-change
+    stop whose crossing is a discontinuity of the equations (Coulomb friction at rest) may never
+    be crossed: an adaptive integrator creeps towards 0 in ever smaller steps (caught within
+    `NEAR_ZERO`), a fixed-step one hops back from near 0 (caught as a bounce: |value| had a
+    minimum within one step's change of 0). Both are placed where the secant of the last two
+    values meets 0.
+    """
+
+    NEAR_ZERO = 1e-9
+
+    def __init__(self, c: CompiledScene, params: list[float], y0: np.ndarray) -> None:
+        self.c, self.params = c, params
+        state = (0.0, np.array(y0, dtype=float), self._values(0.0, np.asarray(y0)))
+        self.last, self.before_last = state, None
+        #: (stop index, t before, y before, t after, y after, how: "crossed" | "secant")
+        self.hit: tuple[int, float, np.ndarray, float, np.ndarray, str] | None = None
+
+    def _values(self, t: float, y: np.ndarray) -> list[float]:
+        n = self.c.n
+        q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
+        return [float(np.asarray(st.value(t, *q, *qd, *self.params)[0])) for st in self.c.stops]
+
+    def guard(self, stop: Any, t: float, y: np.ndarray) -> bool:
+        if stop.only_if is None:
+            return True
+        n = self.c.n
+        q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
+        return float(np.asarray(stop.only_if(t, *q, *qd, *self.params)[0])) >= 0
+
+    def __call__(self, t: float, y: np.ndarray) -> bool:
+        values = self._values(t, y)
+        t1, y1, v1 = self.last
+        for i, stop in enumerate(self.c.stops):
+            before, now = v1[i], values[i]
+            if stop.crossing == "falls":
+                if before > 0 >= now and self.guard(stop, t, y):
+                    self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
+                    return True
+                continue
+            if np.sign(before) != np.sign(now) and before != 0 and self.guard(stop, t, y):
+                self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
+                return True
+            if 0 < abs(now) <= self.NEAR_ZERO and self.guard(stop, t, y):
+                self.hit = (i, t1, y1, t, np.array(y, dtype=float), "secant")
+                return True
+            if self.before_last is not None:
+                t0, y0, v0 = self.before_last
+                lowest = abs(v0[i]) > abs(before) < abs(now) and abs(before) <= abs(before - v0[i])
+                if lowest and np.sign(v0[i]) == np.sign(before) and self.guard(stop, t1, y1):
+                    self.hit = (i, t0, y0, t1, y1, "secant")
+                    return True
+        self.before_last, self.last = self.last, (t, np.array(y, dtype=float), values)
+        return False
+
+    def secant(self, params: list[float]) -> tuple[Any, float, np.ndarray]:
+        """Where the line through the last two values meets 0, one Euler step from the last."""
+        i, t0, y0, t1, y1, _ = self.hit
+        v0, v1 = self._values(t0, y0)[i], self._values(t1, y1)[i]
+        t_stop = t1 if v0 == v1 else t1 + v1 * (t1 - t0) / (v0 - v1)
+        t_stop = min(max(t_stop, t0), t1 + (t1 - t0))
+        return self.c.stops[i], t_stop, y1 + (t_stop - t1) * self.c.rhs(params)(t1, y1)
+
+
+def _watch(c: CompiledScene, params: list[float], y0: np.ndarray) -> StopWatch | None:
+    return StopWatch(c, params, y0) if c.stops else None
+
+
+def _stop_values(c, stop, t, y, params) -> tuple[np.ndarray, np.ndarray | None]:
+    n = c.n
+    (value,) = evaluate(stop.value, t, y[:, :n].T, y[:, n : 2 * n].T, params)
+    guard = None
+    if stop.only_if is not None:
+        (guard,) = evaluate(stop.only_if, t, y[:, :n].T, y[:, n : 2 * n].T, params)
+    return value, guard
+
+
+def refuse_passed_stops(c: CompiledScene, params: list[float], y0: np.ndarray) -> None:
+    """A run may not start where its model already does not hold (a slack string, a block
+    beyond the pulley): that is a 422 naming the initial state, not a motion to show."""
+    errors = []
+    for stop in c.stops:
+        if stop.crossing != "falls":
+            continue
+        value, _ = _stop_values(c, stop, np.array([0.0]), y0[None, :], params)
+        if value[0] < 0:
+            errors.append(
+                {
+                    "field": "initial",
+                    "message": f"the model does not hold in this initial state ({stop.name}: "
+                    f"{stop.message})",
+                }
+            )
+    if errors:
+        raise SpecError(errors)
+
+
+def first_stop(
+    c: CompiledScene, run: Any, params: list[float], req: Any, watch: StopWatch | None = None
+) -> StopEvent | None:
+    """The first declared (or implicit) stop the run reaches, located by re-integrating from the
+    sample before it with scipy's event location (a root of the stop function on the step's
+    dense output, to the run's tolerance). A run that ended early (a watched stop between two
+    samples, a blow-up at a branch point) is searched one sample interval past its last sample.
+    """
+    if not c.stops or len(run.t) < 1:
+        return None
+    if watch is not None and watch.hit is not None:
+        _, t_prev, y_prev, t_hit, _, how = watch.hit
+        found = _locate(c, t_prev, y_prev, t_hit, params, req) if how == "crossed" else None
+        stop, t_stop, y_stop = found or watch.secant(params)
+        return _cut(run, len(run.t), stop, t_stop, y_stop)
+    k = None
+    if len(run.t) >= 2:
+        for stop in c.stops:
+            value, guard = _stop_values(c, stop, run.t, run.y, params)
+            hit = _crossing(value, stop.crossing, guard)
+            if hit is not None and (k is None or hit < k):
+                k = hit
+    if k is not None:
+        t0, y0, t1 = run.t[k - 1], run.y[k - 1], run.t[k]
+    elif run.status != "ok":
+        k = len(run.t)
+        t0, y0 = run.t[-1], run.y[-1]
+        t1 = min(t0 + 1.0 / req.fps, req.t_end) if req.t_end > t0 else t0
+        if t1 <= t0:
+            return None
+    else:
+        return None
+    found = _locate(c, t0, y0, t1, params, req)
+    if found is None:
+        return None
+    stop, t_stop, y_stop = found
+    return _cut(run, k, stop, t_stop, y_stop)
+
+
+def _cut(run: Any, k: int, stop: Any, t_stop: float, y_stop: np.ndarray) -> StopEvent:
+    """The run's first k samples, then the located state at the stop."""
+    k = int(np.searchsorted(run.t[:k], t_stop, "left"))
+    cut = Trajectory(
+        np.append(run.t[:k], t_stop),
+        np.vstack([run.y[:k], y_stop]),
+        "stopped",
+        f"{stop.name} at t = {t_stop:.6g} s",
+        run.nfev,
+        run.nsteps,
+        run.njev,
+        run.wall_time,
+        run.note,
+    )
+    return StopEvent(stop.name, stop.message, float(t_stop), cut)
+
+
+def _crossing(value: np.ndarray, crossing: str, guard: np.ndarray | None) -> int | None:
+    """The first sample index k ≥ 1 at which the condition has been reached since k − 1."""
+    if crossing == "falls":
+        hits = np.nonzero((value[1:] <= 0) & (value[:-1] > 0))[0] + 1
+        if value[0] == 0:
+            hits = np.concatenate([np.nonzero(value[1:] < 0)[0][:1] + 1, hits])
+    else:
+        hits = np.nonzero(np.sign(value[1:]) != np.sign(value[:-1]))[0] + 1
+    for k in np.sort(hits):
+        if guard is None or guard[k] >= 0 or guard[k - 1] >= 0:
+            return int(k)
+    return None
+
+
+#: Right-hand-side calls one location may spend (a chattering discontinuity would take forever).
+_LOCATE_CALLS = 50_000
+
+
+class _LocateBudget(Exception):
+    pass
+
+
+#: Event searches per located stop: a guarded stop whose guard fails is passed and searched on.
+_MAX_EVENT_RESTARTS = 8
+
+
+def _locate(c, t0, y0, t1, params, req) -> tuple[Any, float, np.ndarray] | None:
+    """Integrate [t0, t1] with every stop as a terminal event; the first whose guard holds."""
+    n = c.n
+    method = req.method if req.method in ("RK45", "DOP853", "Radau", "BDF", "LSODA") else "DOP853"
+    fixed = METHODS[req.method].kind == "fixed"
+    rtol, atol = (1e-10, 1e-12) if fixed else (req.rtol, req.atol)
+
+    def event(stop):
+        def g(time: float, y: np.ndarray) -> float:
+            q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
+            return float(np.asarray(stop.value(time, *q, *qd, *params)[0]))
+
+        g.terminal = True
+        g.direction = -1 if stop.crossing == "falls" else 0
+        return g
+
+    events = [event(stop) for stop in c.stops]
+    rhs, calls = c.rhs(params), [0]
+
+    def budgeted(time: float, y: np.ndarray) -> np.ndarray:
+        calls[0] += 1
+        if calls[0] > _LOCATE_CALLS:
+            raise _LocateBudget
+        return rhs(time, y)
+
+    for stop, g in zip(c.stops, events, strict=True):
+        if stop.crossing == "falls" and g(t0, y0) <= 0 and t0 > 0:
+            return stop, float(t0), np.asarray(y0)  # reached on the sample itself
+    start, state = t0, np.asarray(y0, dtype=float)
+    for _ in range(_MAX_EVENT_RESTARTS):
+        try:
+            with np.errstate(all="ignore"):
+                sol = solve_ivp(
+                    budgeted, (start, t1), state, method=method, rtol=rtol, atol=atol, events=events
+                )
+        except (_LocateBudget, *_PHYSICAL):
+            return None
+        hits = [
+            (te[0], i, ye[0])
+            for i, (te, ye) in enumerate(zip(sol.t_events, sol.y_events, strict=True))
+            if len(te)
+        ]
+        if not hits:
+            return None
+        t_hit, i, y_hit = min(hits, key=lambda h: h[0])
+        stop = c.stops[i]
+        q, qd = y_hit[:n].tolist(), y_hit[n : 2 * n].tolist()
+        if stop.only_if is None or float(np.asarray(stop.only_if(t_hit, *q, *qd, *params)[0])) >= 0:
+            return stop, float(t_hit), y_hit
+        if t_hit >= t1:
+            return None
+        start, state = float(np.nextafter(t_hit, np.inf)), y_hit
+    return None
 
 
 def _work(c, t, q, qd, params) -> dict[str, dict[str, list[float]]]:
@@ -299,6 +654,18 @@ def _sensitivity(c, params, y0, t_eval, req, run) -> list[str]:
 def simulate(
     scene_id: str | None = None, scene: dict | None = None, request: SimulationRequest | None = None
 ) -> dict[str, Any]:
-    """Simulate a built-in scene (by id) or a spec; raises SpecError naming bad fields."""
-    c = compiled_scene(scene_id) if scene_id is not None else compiled_spec(scene)
-    return simulate_compiled(c, request or SimulationRequest())
+    """Simulate a built-in scene (by id) or a spec; raises SpecError naming bad fields.
+
+    A state on the other side of a spring's anchor than the derivation's is run on the variant
+    derived for that side (ℓ = −p instead of p), so V = ½k(|d| − ℓ₀)² holds wherever a run starts.
+    """
+    req = request or SimulationRequest()
+    branches: dict[int, int] = {}
+    for _ in range(MAX_BRANCH_FLIPS):
+        key = tuple(sorted(branches.items()))
+        c = compiled_scene(scene_id, key) if scene_id is not None else compiled_spec(scene, key)
+        try:
+            return simulate_compiled(c, req)
+        except _OtherBranch as other:
+            branches = {**c.derivation.model.branches, other.index: other.sign}
+    raise SpecError([{"field": "initial", "message": "no derivation matches this state"}])

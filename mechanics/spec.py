@@ -134,6 +134,27 @@ class Potential(_Model):
     expression: Expr
 
 
+class Stop(_Model):
+    """Where the model stops holding, so a run ends there instead of showing motion it forbids.
+
+    ``when`` (q, q̇, t and parameters) is positive while the model holds; the run stops where it
+    reaches 0 (``crossing = "any"``: where it changes sign either way, e.g. a velocity that
+    reverses). ``tension`` instead names a body whose string tension must stay positive (the
+    string goes slack at 0): the tension toward the point it hangs from (``from``), or, with
+    ``along``, the constraint force on it along that direction (the string of an Atwood machine
+    pulls straight up: ``along = [0, 1, 0]``). ``only_if``, when given, must be ≥ 0 at that
+    moment for the stop to apply (static friction can hold the block: μ cos α − sin α ≥ 0).
+    """
+
+    name: Ident
+    message: Text
+    when: Expr | None = None
+    tension: Ident | None = None
+    along: Annotated[list[float], Field(min_length=2, max_length=3)] | None = None
+    crossing: Literal["falls", "any"] = "falls"
+    only_if: Expr | None = None
+
+
 def _items(model: type) -> Any:
     return Annotated[list[model], Field(max_length=MAX_ITEMS)]
 
@@ -157,6 +178,7 @@ class SceneSpec(_Model):
     forces: _items(Force) = []
     torques: _items(Force) = []
     potentials: _items(Potential) = []
+    stops: _items(Stop) = []
     initial: Annotated[dict[str, float], Field(max_length=2 * MAX_COORDINATES)] = {}
 
     @field_validator("parameters", "initial")
@@ -166,6 +188,44 @@ class SceneSpec(_Model):
             if not math.isfinite(value):
                 raise ValueError(f"{name} must be a finite number")
         return v
+
+
+#: Units of quantities that are nonnegative by nature: mass, length, stiffness, damping, inertia.
+NONNEGATIVE_UNITS = frozenset(
+    {"kg", "m", "N/m", "N*s/m", "N s/m", "kg*m^2", "kg m^2", "kg*m**2", "kg/s"}
+)
+
+
+def nonnegative_parameters(spec: SceneSpec) -> dict[str, str]:
+    """Parameters that are nonnegative by nature, each with what it is, for messages.
+
+    Only these may be assumed ≥ 0 in the algebra (sqrt(l**2) = l) and refused when negative: a
+    charge, a rotation rate or an offset can be negative, and an assumption the API does not
+    enforce would make the derivation wrong for a value it accepts. Nature is read from the
+    role a parameter plays on its own (a body's mass, a spring's k) or from its unit.
+    """
+    roles: dict[str, str] = {}
+
+    def role(value: Any, what: str) -> None:
+        if isinstance(value, str) and value.strip() in spec.parameters:
+            roles.setdefault(value.strip(), what)
+
+    for b in spec.bodies:
+        role(b.mass, "a mass")
+        if b.inertia is not None:
+            for key in ("ixx", "iyy", "izz"):
+                role(getattr(b.inertia, key), "a moment of inertia")
+    for s in spec.springs:
+        role(s.k, "a spring stiffness")
+        role(s.rest_length, "a rest length")
+    for d in spec.dampers:
+        role(d.c, "a damping coefficient")
+    if spec.gravity is not None:
+        role(spec.gravity.acceleration, "the gravitational acceleration")
+    for name, unit in spec.units.items():
+        if name in spec.parameters and unit.strip() in NONNEGATIVE_UNITS:
+            roles.setdefault(name, f"a quantity in {unit.strip()}")
+    return roles
 
 
 _DOT = re.compile(r"^(?P<q>.+?)_(?P<d>d?dot)$")
@@ -250,9 +310,26 @@ def check_names(spec: SceneSpec) -> None:
         if f.on not in bodies or bodies[f.on].kind != "rigid_body":
             err(f"torques[{i}].on", f"'{f.on}' is not a rigid body of this scene")
         check_position(f.vector, f"torques[{i}].vector", places)
+    for i, stop in enumerate(spec.stops):
+        if (stop.when is None) == (stop.tension is None):
+            err(f"stops[{i}].when", "give exactly one of 'when' (an expression) or 'tension'")
+        if stop.tension is not None and stop.tension not in bodies:
+            err(f"stops[{i}].tension", f"unknown body '{stop.tension}'")
+        if stop.along is not None and (
+            stop.tension is None or not all(map(math.isfinite, stop.along)) or not any(stop.along)
+        ):
+            err(f"stops[{i}].along", "a finite, non-zero direction, only with 'tension'")
+        if stop.tension is not None and stop.crossing != "falls":
+            err(f"stops[{i}].crossing", "a string goes slack when its tension falls to 0")
     for i, q in enumerate(spec.positive_coordinates):
         if q not in spec.coordinates:
             err(f"positive_coordinates[{i}]", f"unknown coordinate '{q}'")
+    for name, what in nonnegative_parameters(spec).items():
+        if spec.parameters[name] < 0:
+            err(f"parameters.{name}", f"must be ≥ 0: {name} is {what}")
+    for i, b in enumerate(spec.bodies):
+        if isinstance(b.mass, (int, float)) and b.mass <= 0:
+            err(f"bodies[{i}].mass", "must be > 0: a body needs a positive mass")
     allowed_initial = set(spec.coordinates) | {f"{q}_dot" for q in spec.coordinates}
     for name in spec.initial:
         if name not in allowed_initial:

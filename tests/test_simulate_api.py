@@ -41,7 +41,7 @@ def test_simple_pendulum_small_angle_period_matches_2pi_sqrt_l_over_g():
     period = crossings[1] - crossings[0]
     assert period == pytest.approx(2 * math.pi * math.sqrt(length / g), rel=1e-4)
     assert body["stats"]["energy_error"] < 1e-8
-    assert set(body["energy"]) == {"T", "V", "E", "W_nc"}
+    assert set(body["energy"]) == {"T", "V", "E", "W_nc", "W_drive"}
     assert len(body["positions"]["bob"]["x"]) == len(t)
 
 

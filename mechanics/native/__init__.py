@@ -278,12 +278,15 @@ def _expr(e: sp.Basic | int | float) -> sp.Basic:
 def rhs_source(
     args: Sequence[sp.Symbol],
     n: int,
-    power: sp.Expr,
+    power: sp.Expr | Sequence[sp.Expr],
     accelerations: Sequence[sp.Expr] | None = None,
     mass: Sequence[sp.Expr] | None = None,
     forcing: Sequence[sp.Expr] | None = None,
 ) -> str:
-    """C for dy/dt with y = [q (n), q̇ (n), W_NC]; args = [t, q..., q̇..., params...].
+    """C for dy/dt with y = [q (n), q̇ (n), W_NC, ...]; args = [t, q..., q̇..., params...].
+
+    `power` is the rate of the extra state (the power of the non-conservative forces), or a list
+    of rates, one extra state each (a drive's −∂L/∂t rides along too).
 
     With `accelerations` q̈ is printed directly; otherwise M (row-major) and f are printed and
     M q̈ = f is solved in C (a zero pivot returns RHS_SINGULAR).
@@ -292,26 +295,33 @@ def rhs_source(
     slots |= {a: sp.Symbol(f"y[{i}]") for i, a in enumerate(args[1 : 2 * n + 1])}
     slots |= {a: sp.Symbol(f"p[{k}]") for k, a in enumerate(args[2 * n + 1 :])}
     outputs = [*accelerations] if accelerations is not None else [*mass, *forcing]
-    exprs = [_expr(e).xreplace(slots) for e in [*outputs, power]]
+    rates = list(power) if isinstance(power, (list, tuple)) else [power]
+    exprs = [_expr(e).xreplace(slots) for e in [*outputs, *rates]]
     stray = set().union(*(e.free_symbols for e in exprs)) - set(slots.values())
     if stray:
         raise NativeUnavailable(f"unexpected symbols {sorted(map(str, stray))}")
     temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"))
     try:
-        return _assemble(n, len(args) - 2 * n - 1, temps, reduced, accelerations is not None)
+        return _assemble(
+            n, len(args) - 2 * n - 1, temps, reduced, accelerations is not None, len(rates)
+        )
     except PrintMethodNotImplementedError as exc:
         raise NativeUnavailable(f"cannot generate C: {str(exc).splitlines()[0]}") from exc
 
 
-def _assemble(n: int, n_params: int, temps: list, reduced: list, solved: bool) -> str:
+def _assemble(
+    n: int, n_params: int, temps: list, reduced: list, solved: bool, extras: int = 1
+) -> str:
     printer = _Printer({"strict": True})
     lines = [f"    const double {s} = {printer.doprint(e)};" for s, e in temps]
     if solved:
         lines += [f"    dy[{n + i}] = {printer.doprint(e)};" for i, e in enumerate(reduced[:n])]
     else:
         lines += [f"    a[{i}] = {printer.doprint(e)};" for i, e in enumerate(reduced[: n * n])]
-        lines += [f"    b[{i}] = {printer.doprint(e)};" for i, e in enumerate(reduced[n * n : -1])]
-    lines.append(f"    dy[{2 * n}] = {printer.doprint(reduced[-1])};")
+        forcing = reduced[n * n : n * n + n]
+        lines += [f"    b[{i}] = {printer.doprint(e)};" for i, e in enumerate(forcing)]
+    for i, e in enumerate(reduced[len(reduced) - extras :]):
+        lines.append(f"    dy[{2 * n + i}] = {printer.doprint(e)};")
     body = _checked("\n".join(lines))
     head = [f"    dy[{i}] = y[{n + i}];" for i in range(n)]
     if not solved:
@@ -324,7 +334,7 @@ def _assemble(n: int, n_params: int, temps: list, reduced: list, solved: bool) -
         solve = []
     return "\n".join(
         [
-            f"/* lab: dim {2 * n + 1} params {n_params} */",
+            f"/* lab: dim {2 * n + extras} params {n_params} */",
             "#include <math.h>",
             "" if solved else _SOLVE,
             "int lab_rhs(double t, const double *y, const double *p, double *dy) {",

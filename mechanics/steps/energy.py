@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from mechanics.expr import to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, eq_line, sub, tidy
 
@@ -46,4 +47,12 @@ def energies(model: Model, work: Work) -> Step:
         "(eq. 25); V sums m g h of each body above the datum (eq. 29), ½ k (ℓ − ℓ₀)² of each "
         "spring (eq. 27) and any given potential."
     )
+    for s in model.springs:
+        if s.branch is not None:
+            text += (
+                f" The spring {s.name} lies along a line, so ℓ = |{to_plain(s.branch)}|; it is "
+                f"written ℓ = {to_plain(s.branch)}, the side of its anchor where that is > 0 (the "
+                "initial state's). A run that starts on the other side is derived with the "
+                "opposite sign, and one that reaches ℓ = 0 stops there."
+            )
     return Step("energy", "Kinetic and potential energy", text, lines)

@@ -1,0 +1,73 @@
+"""Refuse a system whose equations of motion do not determine its motion: a singular mass matrix.
+
+A zero mass (or inertia) leaves a coordinate without inertia: M is singular for every state, q̈ is
+undefined, and a simulation would grind through NaN until its budget ran out. That is an input
+error, reported on the fields that cause it, before anything runs. A mass matrix singular only at
+some states (φ at the pole of a sphere) is a property of the coordinates, not an error: runs from
+those states are refused by the simulation instead.
+"""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import sympy as sp
+
+from mechanics.model import T as t
+from mechanics.spec import SpecError
+
+#: States tried: M must be singular at all of them to blame the parameters.
+PROBES = 4
+
+
+def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> bool:
+    """Is M singular (or not positive definite) at every probed state, at these parameters?"""
+    n = M.shape[0]
+    plain = {q: sp.Symbol(f"_q{i}") for i, q in enumerate(model.q)}
+    velocities = {qd: sp.Symbol(f"_u{i}") for i, qd in enumerate(model.qd)}
+    params = [model.params[k] for k in model.spec.parameters]
+    args = [sp.Symbol("_t"), *plain.values(), *velocities.values(), *params]
+    exprs = [e.xreplace(velocities).xreplace(plain).xreplace({t: args[0]}) for e in M]
+    f = sp.lambdify(args, exprs, modules="numpy")
+    rng = random.Random(0)
+    positive = set(model.spec.positive_coordinates)
+    for _ in range(PROBES):
+        q = [
+            rng.uniform(0.5, 1.5) if name in positive else rng.uniform(-1.3, 1.3)
+            for name in model.coordinate_names
+        ]
+        u = [rng.uniform(-1, 1) for _ in model.q]
+        with np.errstate(all="ignore"):
+            try:
+                m = np.array(f(rng.uniform(0, 1), *q, *u, *values.values()), dtype=float)
+            except (ZeroDivisionError, ValueError, TypeError, OverflowError):
+                continue
+        m = m.reshape(n, n)
+        if not np.all(np.isfinite(m)):
+            continue
+        eig = np.linalg.eigvalsh((m + m.T) / 2)
+        if eig.min() > 1e-14 * max(abs(eig).max(), 1e-300):
+            return False
+    return True
+
+
+def check_mass_matrix(derivation) -> None:
+    """Raise SpecError naming the parameters (or bodies) that leave M singular everywhere."""
+    m, M = derivation.model, derivation.work.mass_matrix
+    values = {k: float(v) for k, v in m.spec.parameters.items()}
+    if not singular_everywhere(M, m, values):
+        return
+    used = {str(s) for s in M.free_symbols}
+    culprits = [k for k, v in values.items() if k in used and v <= 0]
+    if culprits:
+        fields = ", ".join(f"parameters.{k}" for k in culprits)
+        said = ", ".join(f"{k} = {values[k]:g}" for k in culprits)
+        message = f"must be > 0: with {said} the mass matrix is singular for every state"
+    else:
+        fields = "bodies"
+        message = (
+            "the mass matrix is singular for every state: some coordinate moves no mass "
+            "(it appears in no body's position or orientation, or only massless ones)"
+        )
+    raise SpecError([{"field": fields, "message": message + ", so q̈ is undefined"}])
