@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from scipy.integrate import cumulative_simpson, solve_ivp
 
+from mechanics.divergence import compare_runs
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
@@ -631,24 +632,21 @@ def _singularity_warnings(c, t, q, qd, params) -> list[str]:
 
 
 def _sensitivity(c, params, y0, t_eval, req, run) -> list[str]:
-    """Re-run at a 1000× looser tolerance; a large difference marks a sensitive motion."""
-    loose = _run(c, params, y0, t_eval, req, min(req.rtol * 1e3, 1e-3), min(req.atol * 1e3, 1e-3))
-    if loose.status != "ok" or len(loose.t) != len(run.t):
+    """Re-run at a 1000× looser tolerance and say how the two runs part.
+
+    Exponentially (chaos: trust the details up to where they part), steadily in phase (a timing
+    drift, told as timing), or not at all; see mechanics/divergence.py. A run cut by a stop is
+    compared over the samples both runs share.
+    """
+    rtol, atol = min(req.rtol * 1e3, 1e-3), min(req.atol * 1e3, 1e-3)
+    loose = _run(c, params, y0, t_eval, req, rtol, atol)
+    shared = min(len(loose.t), len(run.t) - (1 if run.status == "stopped" else 0))
+    if loose.status != "ok" and len(loose.t) < len(run.t) or shared < 3:
         return []
-    n = c.n
-    diff = np.abs(loose.y[:, :n] - run.y[:, :n])
-    span = np.max(np.abs(run.y[:, :n]), axis=0) + 1e-12
-    rel = np.max(diff / span, axis=0)
-    worst = int(np.argmax(rel))
-    if rel[worst] < 1e-2:
-        return []
-    i = int(np.argmax(diff[:, worst] / span[worst] > 1e-2))
-    return [
-        f"The motion is sensitive to small errors: at rtol {req.rtol:g} and "
-        f"{min(req.rtol * 1e3, 1e-3):g} the trajectories of {c.coordinates[worst]} part "
-        f"from t ≈ {run.t[i]:.3g} s (difference {diff[-1, worst]:.3g} at the end). Trust it "
-        "only up to there, or tighten the tolerance and compare again."
-    ]
+    verdict = compare_runs(
+        c, params, run.t[:shared], run.y[:shared], loose.y[:shared], (req.rtol, rtol)
+    )
+    return [verdict.message] if verdict.message else []
 
 
 def simulate(
