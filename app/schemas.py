@@ -339,9 +339,39 @@ class Equilibrium(BaseModel):
     )
     free: list[str] = Field(description="Coordinates absent from the conditions (any value).")
     exists_when: str = Field(description="Condition for existence, e.g. |g/(Omega**2*R)| <= 1.")
-    stable: bool
-    frequencies: list[float] = Field(description="Small-oscillation ω in rad/s, ascending.")
-    modes: list[list[float]] = Field(description="Normal mode shapes, one per frequency.")
+    found_by: str = Field(
+        description="closed form / closed form, confirmed numerically / numeric search."
+    )
+    stable: bool = Field(
+        description="True for the kinds stable, asymptotically stable, gyroscopically stable."
+    )
+    kind: str = Field(
+        description="What the eigenvalues of M δq̈ + C δq̇ + K δq = 0 decide: stable, "
+        "asymptotically stable, gyroscopically stable, marginal or unstable.",
+        json_schema_extra={
+            "enum": [
+                "stable",
+                "asymptotically stable",
+                "gyroscopically stable",
+                "marginal",
+                "unstable",
+            ]
+        },
+    )
+    reason: str = Field(description="Why, in words: the eigenvalues and K that decided.")
+    eigenvalues: list[list[float]] = Field(
+        description="[Re λ, Im λ] of the first-order linearized system, δq ∝ e^(λt)."
+    )
+    frequencies: list[float] = Field(
+        description="Small-oscillation ω = Im λ in rad/s, ascending (none when unstable)."
+    )
+    modes: list[list[float]] = Field(
+        description="Normal mode shapes (max |·| = 1), one per frequency; amplitudes when the "
+        "mode whirls (see mode_phases)."
+    )
+    mode_phases: list[list[float]] = Field(
+        description="Phase of each coordinate in each mode, rad (all 0: a standing pattern)."
+    )
 
 
 class EquilibriaResponse(BaseModel):

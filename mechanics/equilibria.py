@@ -3,19 +3,31 @@
 At rest every q̇ and q̈ vanish, and the equations of motion reduce to f_j(q, 0, t) = 0: for a
 scleronomic system that is δW = Σ_j (Q_j^NC − ∂V/∂q_j) δq_j = 0 for arbitrary δq_j; where frames
 turn at a prescribed rate it also keeps the centrifugal terms, which is what "equilibrium in the
-rotating frame" means (the bead on a spinning hoop). Solutions are found symbolically where sympy
-can (with the conditions under which they exist), numerically otherwise. Linearizing about each
-gives M δq̈ + C δq̇ + K δq = 0; K v = ω² M v gives the normal modes.
+rotating frame" means (the bead on a spinning hoop).
+
+Roots are found twice, so that none is silently missed or invented: sympy's closed forms (with the
+conditions under which they exist), each checked by plugging it back in, and always a bounded
+numeric search (Newton from a capped set of starts), whose roots are matched to the closed forms or
+added. A coordinate is an angle, wrapped into (−π, π], when the equations are 2π-periodic in it (it
+enters only through sin/cos of itself), whatever its declared units say.
+
+Linearizing about each gives M δq̈ + C δq̇ + K δq = 0 (C: damping and the gyroscopic/Coriolis
+terms). Stability and frequencies come from the eigenvalues of the first-order system, not from K
+alone: a turntable's Coriolis terms split and can even restore frequencies K alone gets wrong.
+
+The module is past the house's ~400 lines because the root search, its checks and the stability
+verdict are one procedure whose parts only make sense together.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+import time
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import scipy.linalg
-import scipy.optimize
 import sympy as sp
 
 from mechanics.derive import Derivation
@@ -27,14 +39,51 @@ from mechanics.steps.conserved import explicit_time
 
 SYMBOLIC_OPS_LIMIT = 200
 TOL = 1e-9
+#: The numeric search's bounds: a posted spec may be anything, the search must still end.
+MAX_STARTS = 256
+MAX_NEWTON_STEPS = 60
+SEARCH_SECONDS = 3.0
+MAX_EQUILIBRIA = 24
+#: Springs along a line are derived on one side of their anchor; at most this many sides in all.
+MAX_BRANCH_VARIANTS = 8
+
+KINDS = ("stable", "asymptotically stable", "gyroscopically stable", "marginal", "unstable")
+STABLE_KINDS = frozenset(KINDS[:3])
+_TRIG = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+
+
+@dataclass
+class Root:
+    """One equilibrium: values by coordinate index, closed forms where known, and its origin."""
+
+    numeric: dict[int, float]
+    symbolic: dict[int, sp.Expr] = field(default_factory=dict)
+    exists: str = "always"
+    how: str = "closed form"
+
+
+@dataclass
+class Verdict:
+    """What the eigenvalues of the linearization say, and why, in words."""
+
+    kind: str
+    reason: str
+    eigenvalues: list[complex]
+    frequencies: list[float]
+    modes: list[list[float]]
+    phases: list[list[float]]
+    linear: dict | None
+
+    @property
+    def stable(self) -> bool:
+        return self.kind in STABLE_KINDS
 
 
 def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dict[str, Any]:
     """Steps in the notes' order and every equilibrium at the given parameter values."""
-    m, w = d.model, d.work
+    m = d.model
     values = {m.params[k]: sp.Float(v) for k, v in _checked(d, parameters or {}).items()}
-    rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
-    conditions = [tidy(fj.xreplace(rest), m) for fj in w.forcing]
+    conditions = _at_rest(Variant(m, d.work.mass_matrix, d.work.forcing, []))
     steps = [_virtual_work_step(d, conditions)]
     warnings: list[str] = []
     conditions = [_drop_idle_drive(c, m, values) for c in conditions]
@@ -44,37 +93,65 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             "equilibrium. Set the drive amplitude to 0 to find the undriven ones."
         )
         return {"steps": [s.to_json() for s in steps], "equilibria": [], "warnings": warnings}
-    free = [j for j, c in enumerate(conditions) if c == 0]
-    bound = [j for j in range(len(m.q)) if j not in free]
-    found = _symbolic(d, conditions, bound, values) if bound else [({}, {}, "always")]
-    if found is None:
-        found = _numeric(d, conditions, bound, values)
+    periods = _periods(d)
+    found: list[tuple[Derivation, Root]] = []
+    variants = _variants(d, warnings)
+    for variant in variants:
+        conds = _at_rest(variant) if variant.label and len(variants) > 1 else conditions
+        if len(variants) > 1:
+            steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
+        conds = [_drop_idle_drive(c, m, values) for c in conds]
+        roots, notes = _equilibrium_points(variant, conds, values, periods)
+        for note in notes:
+            if note not in warnings:
+                warnings.append(note)
+        for root in roots:
+            if not any(_same(root.numeric, r.numeric, periods) for _, r in found):
+                found.append((variant, root))
+    found.sort(key=lambda vr: [abs(vr[1].numeric.get(j, 0.0)) for j in range(len(m.q))])
+    if len(found) > MAX_EQUILIBRIA:
         warnings.append(
-            "sympy could not solve the conditions in closed form: the equilibria "
-            "below were found numerically."
+            f"More than {MAX_EQUILIBRIA} equilibria (a continuum?): only the first "
+            f"{MAX_EQUILIBRIA} are listed."
         )
-    results, linearized = [], []
-    for numeric_q, symbolic_q, exists in found:
-        q0 = [numeric_q.get(j, 0.0) for j in range(len(m.q))]
-        stable, freqs, modes, linear = _stability(d, q0, len(free), values)
-        linearized.append(linear)
-        results.append(
-            {
-                "q": {m.coordinate_names[j]: q0[j] for j in range(len(m.q))},
-                "symbolic": {m.coordinate_names[j]: to_plain(symbolic_q[j]) for j in symbolic_q},
-                "free": [m.coordinate_names[j] for j in free],
-                "exists_when": exists,
-                "stable": stable,
-                "frequencies": freqs,
-                "modes": modes,
-            }
-        )
+        found = found[:MAX_EQUILIBRIA]
+    free = [j for j, c in enumerate(conditions) if c == 0]
+    results, verdicts = [], []
+    for variant, root in found:
+        q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
+        verdict = _stability(variant, q0, free, values)
+        verdicts.append(verdict)
+        results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
-    results, linearized = [results[i] for i in order], [linearized[i] for i in order]
-    steps.append(_stability_step(d, results, linearized))
+    results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
+    steps.append(_stability_step(results, verdicts))
     if not results:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _result_json(m: Any, root: Root, free: list[int], v: Verdict, q0: list[float]) -> dict:
+    names = m.coordinate_names
+    return {
+        "q": {names[j]: float(q0[j]) + 0.0 for j in range(len(m.q))},
+        "symbolic": {names[j]: to_plain(root.symbolic[j]) for j in root.symbolic},
+        "free": [names[j] for j in free],
+        "exists_when": root.exists,
+        "found_by": root.how,
+        "stable": v.stable,
+        "kind": v.kind,
+        "reason": v.reason,
+        "eigenvalues": [[float(z.real), float(z.imag)] for z in v.eigenvalues],
+        "frequencies": v.frequencies,
+        "modes": v.modes,
+        "mode_phases": v.phases,
+    }
+
+
+def _at_rest(v: Variant) -> list[sp.Expr]:
+    m = v.model
+    rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
+    return [tidy(fj.xreplace(rest), m) for fj in v.forcing]
 
 
 def _drop_idle_drive(c: sp.Expr, m: Any, values: dict) -> sp.Expr:
@@ -116,15 +193,7 @@ def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
                     f"delta r_{b.name}",
                 )
             )
-    for name, q, c in zip(m.coordinate_names, m.q, conditions, strict=True):
-        lines.append(
-            Line(
-                f"Q_{name} at rest",
-                rf"Q_{{{to_latex(q)}}}\big|_{{\dot q = 0}} = "
-                f"{to_latex(c)} = 0",
-                f"Q_{name} = {to_plain(c)} = 0",
-            )
-        )
+    lines += _condition_lines(d, conditions)
     text = (
         "Constraint forces do no virtual work, so only the applied forces enter: "
         "δW = Σ_j Q_j δq_j with Q_j = Q_j^NC − ∂V/∂q_j evaluated at rest (q̇ = 0; where a "
@@ -134,44 +203,215 @@ def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
     return Step("virtual_work", "Equilibrium by virtual work", text, lines)
 
 
-def _symbolic(d, conditions, bound, values):
-    """Closed-form roots with their existence conditions, or None when sympy cannot."""
+def _condition_lines(d: Derivation, conditions: list[sp.Expr], where: str = "") -> list[Line]:
     m = d.model
-    eqs = [conditions[j] for j in bound]
+    return [
+        Line(
+            f"Q_{name} at rest{where}",
+            rf"Q_{{{to_latex(q)}}}\big|_{{\dot q = 0}} = {to_latex(c)} = 0",
+            f"Q_{name} = {to_plain(c)} = 0{where}",
+        )
+        for name, q, c in zip(m.coordinate_names, m.q, conditions, strict=True)
+    ]
+
+
+# --- which coordinates are angles ------------------------------------------------------------
+
+
+def _periods(d: Derivation) -> dict[int, float]:
+    """2π for every coordinate the equations are 2π-periodic in: it enters only through
+    sin/cos (…) of integer multiples of itself. Declared units alone do not make an angle
+    periodic (a torsion spring ½kθ² is not), and a posted spec often has no units at all."""
+    m, w = d.model, d.work
+    dummies = {s: sp.Dummy() for s in (*m.qdd, *m.qd)}
+    q_syms = {q: sp.Dummy(f"q{j}") for j, q in enumerate(m.q)}
+    exprs = [e.xreplace(dummies).xreplace(q_syms) for e in (*w.forcing, *w.mass_matrix)]
+    periods = {}
+    for j, q in enumerate(m.q):
+        x = q_syms[q]
+        present = any(e.has(x) for e in exprs)
+        is_angle = m.spec.units.get(m.coordinate_names[j]) == "rad"
+        if present and all(_enters_periodically(e, x) for e in exprs):
+            periods[j] = 2 * math.pi
+        elif not present and is_angle:
+            periods[j] = 2 * math.pi
+    return periods
+
+
+def _enters_periodically(expr: sp.Expr, x: sp.Symbol) -> bool:
+    if expr == x:
+        return False
+    if not expr.has(x):
+        return True
+    if isinstance(expr, _TRIG):
+        arg = expr.args[0]
+        c = arg.diff(x)
+        if c.is_integer and c != 0 and not (arg - c * x).has(x):
+            return True
+    return all(_enters_periodically(a, x) for a in expr.args)
+
+
+def _wrap(value: float, period: float | None) -> tuple[float, int]:
+    """Angles into (−π, π]; returns the value and the whole turns taken off."""
+    if period is None:
+        return value, 0
+    turns = math.floor((value + math.pi) / (2 * math.pi))
+    wrapped = value - 2 * math.pi * turns
+    if wrapped <= -math.pi + 1e-12:
+        wrapped += 2 * math.pi
+        turns -= 1
+    return wrapped, turns
+
+
+def _same(a: dict[int, float], b: dict[int, float], periods: dict[int, float]) -> bool:
+    for j in set(a) | set(b):
+        x, y = a.get(j, 0.0), b.get(j, 0.0)
+        diff = x - y
+        if j in periods:
+            diff = math.remainder(diff, periods[j])
+        if abs(diff) > 1e-6 * (1 + abs(x)):
+            return False
+    return True
+
+
+# --- springs along a line: both sides of the anchor ------------------------------------------
+
+
+@dataclass
+class Variant:
+    """The equations with each spring along a line on one side of its anchor.
+
+    Such a spring is derived as ℓ = p without |·|, valid while p > 0: an equilibrium on the other
+    side (x = −ℓ₀) solves the equations with ℓ = −p. ½k(−p − ℓ₀)² − ½k(p − ℓ₀)² = 2kℓ₀p, so that
+    variant's forcing is f − 2kℓ₀ ∂p/∂q, valid while −p > 0: no new derivation is needed."""
+
+    model: Any
+    mass_matrix: sp.Matrix
+    forcing: sp.Matrix
+    ranges: list[sp.Expr]
+    label: str = ""
+
+
+def _variants(d: Derivation, warnings: list[str]) -> list[Variant]:
+    m, w = d.model, d.work
+    springs = [s for s in m.springs if getattr(s, "branch", None) is not None]
+    variants = []
+    for flips in itertools.product((False, True), repeat=len(springs)):
+        if len(variants) >= MAX_BRANCH_VARIANTS:
+            warnings.append(
+                "Many springs lie along lines: only some sides of their anchors were searched "
+                "for equilibria."
+            )
+            break
+        forcing, ranges, where = w.forcing, [], []
+        for s, flip in zip(springs, flips, strict=True):
+            p = -s.branch if flip else s.branch
+            if flip:
+                extra = 2 * s.k * s.rest_length * sp.Matrix([s.branch.diff(q) for q in m.q])
+                forcing = forcing - extra
+            ranges.append(p)
+            where.append(f"{s.name}: ℓ = {to_plain(p)}")
+        variants.append(Variant(m, w.mass_matrix, forcing, ranges, ", ".join(where)))
+    return variants
+
+
+# --- the roots: closed form, checked and completed by a numeric search -----------------------
+
+
+def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], list[str]]:
+    m = v.model
+    notes: list[str] = []
+    free = [j for j, c in enumerate(conditions) if c == 0]
+    bound = [j for j in range(len(m.q)) if j not in free]
+    if not bound:
+        return [Root({}, {}, "always")], notes
+    to_zero = {m.q[j]: 0 for j in free}
+    eqs = [conditions[j].xreplace(to_zero) for j in bound]
+    system = _System(v, eqs, bound, values, periods)
+    symbolic = _symbolic(m, eqs, bound, values, periods)
+    numeric = _numeric_search(system)
+    roots: list[Root] = []
+    for root in symbolic or []:
+        x = np.array([[root.numeric[j]] for j in bound])
+        if not system.in_range(x)[0]:
+            continue  # the other side of a spring's anchor, or a positive coordinate < 0
+        if not system.residual_ok(x)[0]:
+            notes.append(
+                "sympy gave "
+                + ", ".join(
+                    f"{m.coordinate_names[j]} = {to_plain(root.symbolic[j])}" for j in bound
+                )
+                + ", which does not satisfy the conditions at these parameters: left out."
+            )
+            continue
+        if not any(_same(root.numeric, r.numeric, periods) for r in roots):
+            roots.append(root)
+    confirmed = 0
+    for x in numeric:
+        point = dict(zip(bound, x, strict=True))
+        match = next((r for r in roots if _same(point, r.numeric, periods)), None)
+        if match is not None:
+            match.how = "closed form, confirmed numerically"
+            confirmed += 1
+            continue
+        closed = _closed_form_guess(m, eqs, bound, point, periods)
+        if closed is not None:
+            roots.append(Root(point, closed, "always", "numeric search, closed form recognised"))
+        else:
+            roots.append(Root(point, {}, "numeric", "numeric search"))
+    if symbolic is None:
+        notes.append(
+            "sympy could not solve the conditions in closed form: the equilibria "
+            "below were found numerically."
+        )
+    elif len(roots) > len(symbolic):
+        notes.append(
+            "The numeric search found equilibria that sympy's closed-form solution missed; "
+            "they are listed too."
+        )
+    if system.timed_out:
+        notes.append(
+            f"The numeric search stopped at its time limit ({SEARCH_SECONDS:g} s): "
+            "equilibria may be missing."
+        )
+    return roots, notes
+
+
+def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
+    """Closed-form roots with their existence conditions, or None when sympy cannot."""
     if len(bound) > 2 or sum(sp.count_ops(e) for e in eqs) > SYMBOLIC_OPS_LIMIT:
         return None
+    if len(bound) == 2 and any(e.has(*_TRIG) for e in eqs):
+        return None  # sp.solve can run for minutes on two trig equations; the search covers it
     subs = {m.q[j]: sp.Symbol(f"_q{j}", real=True) for j in bound}
     back = {v: k for k, v in subs.items()}
     try:
-        sols = sp.solve([e.xreplace(subs) for e in eqs], list(subs.values()), dict=True)
+        sols = sp.solve(
+            [e.xreplace(subs) for e in eqs], list(subs.values()), dict=True, check=False
+        )
     except (NotImplementedError, ValueError, TypeError):
         return None
     if not sols and not all(_never_zero(e, values) for e in eqs):
         return None
     out = []
-    seen: list[list[float]] = []
     for sol in sols:
-        if len(sol) < len(bound):
+        if len(sol) < len(bound) or any(v.free_symbols & set(subs.values()) for v in sol.values()):
             return None
         numeric, symbolic, conditions_text = {}, {}, []
-        ok = True
         for j in bound:
             expr = sol[subs[m.q[j]]].xreplace(back)
             conditions_text += _existence(expr)
-            value = complex(expr.xreplace(values).evalf())
+            try:
+                value = complex(expr.xreplace(values).evalf())
+            except (TypeError, ValueError):
+                value = complex(math.nan)
             if abs(value.imag) > 1e-12 or not math.isfinite(value.real):
-                ok = False
                 break
-            wrapped, turns = _wrap(value.real, m.spec.units.get(m.coordinate_names[j]))
+            wrapped, turns = _wrap(value.real, periods.get(j))
             numeric[j] = wrapped
             symbolic[j] = expr - 2 * sp.pi * turns if turns else expr
-        if not ok:
-            continue
-        key = [numeric[j] for j in bound]
-        if any(np.allclose(key, s, atol=1e-9) for s in seen):
-            continue
-        seen.append(key)
-        out.append((numeric, symbolic, " and ".join(conditions_text) or "always"))
+        else:
+            out.append(Root(numeric, symbolic, " and ".join(conditions_text) or "always"))
     return out
 
 
@@ -190,57 +430,180 @@ def _existence(expr: sp.Expr) -> list[str]:
     return out
 
 
-def _wrap(value: float, unit: str | None) -> tuple[float, int]:
-    """Angles into (−π, π]; returns the value and the whole turns taken off."""
-    if unit != "rad":
-        return value, 0
-    turns = math.floor((value + math.pi) / (2 * math.pi))
-    wrapped = value - 2 * math.pi * turns
-    if wrapped <= -math.pi + 1e-12:
-        wrapped += 2 * math.pi
-        turns -= 1
-    return wrapped, turns
+def _closed_form_guess(m, eqs, bound, point, periods) -> dict[int, sp.Expr] | None:
+    """A numeric root at a simple value (kπ/12 for an angle, 0 or ± a parameter otherwise) that
+    makes every condition vanish for any parameter values is a closed form that holds always."""
+    guesses = {}
+    for j in bound:
+        x = point[j]
+        candidates = [sp.S.Zero]
+        if j in periods:
+            candidates += [sp.pi * k / 12 for k in range(-11, 13) if k]
+        else:
+            for p, v in m.spec.parameters.items():
+                candidates += [m.params[p], -m.params[p]] if abs(abs(x) - abs(v)) < 1e-6 else []
+        hit = [c for c in candidates if abs(float(c.xreplace(_param_values(m))) - x) < 1e-7]
+        if not hit:
+            return None
+        guesses[j] = hit[0]
+    exact = [e.xreplace({m.q[j]: guesses[j] for j in bound}) for e in eqs]
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        trial = {s: sp.Float(rng.uniform(0.5, 2.0)) for s in m.params.values()}
+        for e in exact:
+            try:
+                value = complex(e.xreplace(trial).evalf())
+            except (TypeError, ValueError):
+                return None
+            scale = sum(abs(complex(a.xreplace(trial).evalf())) for a in sp.Add.make_args(e))
+            if not abs(value) <= 1e-10 * (1 + scale):
+                return None
+    return guesses
 
 
-def _numeric(d, conditions, bound, values):
-    """Roots from a grid of starting points, deduplicated; angles wrapped."""
-    m = d.model
-    f = sp.lambdify(
-        [[m.q[j] for j in bound]], [conditions[j].xreplace(values) for j in bound], modules="numpy"
-    )
-    starts = []
-    rng = np.random.default_rng(0)
-    for _ in range(40):
-        starts.append(
-            [
-                rng.uniform(-math.pi, math.pi)
-                if m.spec.units.get(m.coordinate_names[j]) == "rad"
-                else rng.uniform(-2, 2)
-                for j in bound
-            ]
+def _param_values(m) -> dict:
+    return {m.params[k]: sp.Float(v) for k, v in m.spec.parameters.items()}
+
+
+class _System:
+    """The conditions as vectorized numpy functions of the bound coordinates, with their
+    Jacobian, a residual scale per condition, and the coordinates' range (a declared positive
+    coordinate > 0; a spring along a line on the side it was derived for)."""
+
+    def __init__(self, v: Variant, eqs, bound, values, periods):
+        m = v.model
+        self.n = len(bound)
+        self.bound = bound
+        self.periods = [periods.get(j) for j in bound]
+        xs = [sp.Dummy(f"x{j}") for j in bound]
+        to_x = {m.q[j]: x for j, x in zip(bound, xs, strict=True)}
+        to_x.update({q: 0 for q in m.q if q not in to_x})
+        f = [e.xreplace(values).xreplace(to_x) for e in eqs]
+        self.f = _vectorized(f, xs)
+        self.jac = _vectorized([fi.diff(x) for fi in f for x in xs], xs)
+        self.scale = _vectorized(
+            [sp.Add(*(sp.Abs(a) for a in sp.Add.make_args(fi))) for fi in f], xs
         )
+        ranges = [m.q[j] for j in bound if m.coordinate_names[j] in m.spec.positive_coordinates]
+        ranges += v.ranges
+        self.ranges = _vectorized([r.xreplace(values).xreplace(to_x) for r in ranges], xs)
+        self.param_values = sorted({abs(float(v)) for v in values.values()} - {0.0})
+        self.spread = max([1.0, *self.param_values])
+        self.typical = 1.0
+        self.timed_out = False
+
+    def residual_ok(self, X: np.ndarray) -> np.ndarray:
+        """Columns of X where every condition vanishes to round-off of its own terms."""
+        F, S = self.f(X), self.scale(X)
+        ok = np.abs(F) <= 1e-9 * (S + 1e-3 * self.typical)
+        return np.all(ok & np.isfinite(F), axis=0)
+
+    def in_range(self, X: np.ndarray) -> np.ndarray:
+        R = self.ranges(X)
+        return np.all(R > 1e-9, axis=0) if len(R) else np.ones(X.shape[1], dtype=bool)
+
+
+def _vectorized(exprs: list[sp.Expr], xs: list[sp.Symbol]):
+    """numpy function of X (n × S) returning len(exprs) × S, nan where not real or finite."""
+    fn = sp.lambdify(xs, exprs, modules="numpy")
+
+    def call(X: np.ndarray) -> np.ndarray:
+        if not exprs:
+            return np.zeros((0, X.shape[1]))
+        with np.errstate(all="ignore"):
+            out = fn(*X)
+        rows = []
+        for o in out:
+            a = np.broadcast_to(np.asarray(o), X.shape[1:])
+            if np.iscomplexobj(a):
+                a = np.where(np.abs(a.imag) > 1e-12, np.nan, a.real)
+            rows.append(a.astype(float))
+        return np.array(rows)
+
+    return call
+
+
+def _numeric_search(system: _System) -> list[list[float]]:
+    """Newton's method from a capped grid of starts, all at once; converged, in-range roots,
+    wrapped and deduplicated. Bounded: MAX_STARTS starts, MAX_NEWTON_STEPS steps, and a clock."""
+    n = system.n
+    X = _starts(system).T  # n × S
+    with np.errstate(all="ignore"):
+        S = system.scale(X)
+    finite = S[np.isfinite(S)]
+    system.typical = float(np.median(finite)) if finite.size else 1.0
+    step_cap = np.array([1.0 if p else 0.5 * system.spread for p in system.periods])
+    deadline = time.monotonic() + SEARCH_SECONDS
+    for _ in range(MAX_NEWTON_STEPS):
+        if time.monotonic() > deadline:
+            system.timed_out = True
+            break
+        F = system.f(X)
+        J = system.jac(X).reshape(n, n, -1).transpose(2, 0, 1)
+        bad = ~(np.all(np.isfinite(F), axis=0) & np.all(np.isfinite(J), axis=(1, 2)))
+        J[bad], F[:, bad] = 0.0, 0.0
+        with np.errstate(all="ignore"):
+            step = np.einsum("sij,sj->si", np.linalg.pinv(J, rcond=1e-13), F.T).T
+        too_far = np.max(np.abs(step) / step_cap[:, None], axis=0)
+        step /= np.maximum(too_far, 1.0)
+        X = X - step
+        X[:, bad] = np.nan
+        for i, p in enumerate(system.periods):
+            if p:
+                X[i] -= 2 * math.pi * np.floor((X[i] + math.pi) / (2 * math.pi))
+        if np.all(~np.isfinite(X[0]) | (np.max(np.abs(step), axis=0) < 1e-15)):
+            break
+    alive = np.all(np.isfinite(X), axis=0)
+    X = X[:, alive]
+    X = X[:, system.residual_ok(X) & system.in_range(X)]
     found: list[list[float]] = []
-    for x0 in starts:
-        sol = scipy.optimize.root(lambda x: np.asarray(f(list(x)), dtype=float), x0)
-        if not sol.success or np.max(np.abs(f(list(sol.x)))) > 1e-8:
-            continue
-        x = [
-            _wrap(v, m.spec.units.get(m.coordinate_names[j]))[0]
-            for v, j in zip(sol.x, bound, strict=True)
-        ]
-        if not any(np.allclose(x, y, atol=1e-7) for y in found):
+    for x in X.T:
+        x = [_wrap(float(v), p)[0] + 0.0 for v, p in zip(x, system.periods, strict=True)]
+        point = dict(enumerate(x))
+        periods = {i: p for i, p in enumerate(system.periods) if p}
+        if not any(_same(point, dict(enumerate(y)), periods) for y in found):
             found.append(x)
-    return [({j: v for j, v in zip(bound, x, strict=True)}, {}, "numeric") for x in found]
+    return found
 
 
-def _stability(d, q0, n_free, values):
-    """K = −∂f/∂q, C = −∂f/∂q̇ at rest; stable when no mode grows.
+def _starts(system: _System) -> np.ndarray:
+    """A grid over each coordinate's range (angles: multiples of π/8 in (−π, π]; lengths: 0 and
+    ± a ladder up to a few times the largest parameter), sampled down to MAX_STARTS."""
+    values, spread = system.param_values, system.spread
+    axes = []
+    for p in system.periods:
+        if p:
+            axes.append([k * math.pi / 8 + 0.01 for k in range(-7, 9)])
+        else:
+            ladder = [spread * 2.0**e for e in range(-4, 3)]
+            ladder += [v * 1.1 for v in values if v > 0] + [v * 0.9 for v in values if v > 0]
+            axes.append([0.013] + ladder + [-v for v in ladder])
+    grid = list(itertools.product(*axes))
+    if len(grid) > MAX_STARTS:
+        rng = np.random.default_rng(0)
+        grid = [grid[i] for i in sorted(rng.choice(len(grid), MAX_STARTS - 1, replace=False))]
+        grid.insert(
+            0,
+            tuple(
+                axis[len(axis) // 2 - 1] if p else axis[0]
+                for axis, p in zip(axes, system.periods, strict=True)
+            ),
+        )  # near q = 0 always
+    return np.array(grid, dtype=float)
+
+
+# --- stability from the full linearization ---------------------------------------------------
+
+
+def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Verdict:
+    """M δq̈ + C δq̇ + K δq = 0 with K = −∂f/∂q, C = −∂f/∂q̇ at rest; the eigenvalues λ of the
+    first-order system decide (δq ∝ e^{λt}), and why is put in words.
 
     Every coordinate takes part (a free cart still moves with its pendulum), except one whose
     mass-matrix row vanishes there: a coordinate singularity such as φ at the pole of a sphere.
-    Zero-frequency modes are neutral where coordinates are free (cyclic), unstable otherwise.
+    Zero eigenvalues are neutral along free (cyclic) coordinates, undecided otherwise.
     """
-    m, w = d.model, d.work
+    m = v.model
     point = {**values, **{q: sp.Float(v) for q, v in zip(m.q, q0, strict=True)}}
     rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
 
@@ -248,35 +611,193 @@ def _stability(d, q0, n_free, values):
         return float(sp.S.Zero + e.xreplace(rest).xreplace(point))
 
     n = len(m.q)
-    full_M = np.array([[num(w.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
+    full_M = np.array([[num(v.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
     idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12]
-    n_free -= n - len(idx)
-    f = [w.forcing[j] for j in idx]
+    if not idx:
+        return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
+    f = [v.forcing[j] for j in idx]
     K = np.array([[-num(fj.diff(m.q[k])) for k in idx] for fj in f])
     C = np.array([[-num(fj.diff(m.qd[k])) for k in idx] for fj in f])
     M = full_M[np.ix_(idx, idx)]
-    if not idx:
-        return True, [], [], None
-    A = np.block(
-        [[np.zeros_like(M), np.eye(len(idx))], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]]
-    )
-    growth = np.max(np.linalg.eigvals(A).real)
-    w2, vecs = scipy.linalg.eigh((K + K.T) / 2, M)
-    zero = np.abs(w2) <= TOL * max(1.0, np.max(np.abs(w2)))
-    stable = bool(growth <= 1e-7 and np.all(w2 > -TOL) and zero.sum() <= max(n_free, 0))
-    freqs, modes = [], []
-    if stable:
-        for i in np.argsort(w2):
-            if zero[i]:
-                continue
-            v = vecs[:, i] / np.max(np.abs(vecs[:, i]))
-            mode = [0.0] * n
-            for j, x in zip(idx, v, strict=True):
-                mode[j] = float(x)
-            freqs.append(float(math.sqrt(w2[i])))
-            modes.append(mode)
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
-    return stable, freqs, modes, linear
+    n_free = len([j for j in free if j in idx])
+    kind, reason, lam, vecs = _classify(M, C, K, n_free, [m.coordinate_names[j] for j in idx])
+    freqs, modes, phases = [], [], []
+    if kind != "unstable":
+        freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
+    return Verdict(kind, reason, list(lam), freqs, modes, phases, linear)
+
+
+def _classify(M, C, K, n_free, names):
+    n = len(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    lam, vecs = np.linalg.eig(A)
+    order = np.lexsort((-lam.imag, -lam.real))
+    lam, vecs = lam[order], vecs[:, order]
+    scale = max(1.0, float(np.max(np.abs(lam))))
+    tol = 1e-7 * scale
+    Ks, Cs = (K + K.T) / 2, (C + C.T) / 2
+    k_norm = max(float(np.max(np.abs(K))), 1e-300)
+    symmetric = np.max(np.abs(K - K.T)) <= 1e-9 * k_norm
+    damped = np.max(np.abs(Cs), initial=0.0) > 1e-12 * max(1.0, float(np.max(np.abs(C))))
+    gyroscopic = np.max(np.abs(C - Cs), initial=0.0) > 1e-12
+    k_eigs = np.linalg.eigvalsh(Ks)
+    k_tol = 1e-9 * max(1.0, float(np.max(np.abs(k_eigs))))
+    k_null = int(np.sum(np.abs(k_eigs) <= k_tol))
+    k_pd_off_free = symmetric and int(np.sum(k_eigs > k_tol)) == n - n_free and k_null == n_free
+    c_psd = np.all(np.linalg.eigvalsh(Cs) >= -1e-9 * max(1.0, float(np.max(np.abs(C)))))
+    shown = _eigen_text(lam)
+    if np.max(lam.real) > tol:
+        grow = lam[np.argmax(lam.real)]
+        reason = (
+            f"an eigenvalue has positive real part (λ = {_z(grow)}): a small displacement "
+            f"grows like e^({grow.real:.4g} t)"
+        )
+        if np.min(k_eigs) < -k_tol and not gyroscopic:
+            reason += "; K has a negative eigenvalue: the potential has no minimum here"
+        return "unstable", reason, lam, vecs
+    zero = np.abs(lam) <= 1e-6 * scale
+    if k_null > n_free:
+        return (
+            "marginal",
+            "K is singular in a direction that is not a free coordinate (eigenvalues "
+            f"{shown}): the quadratic approximation is flat there, so the linear test cannot "
+            "decide; higher-order terms do (a bifurcation point, or a family of equilibria)",
+            lam,
+            vecs,
+        )
+    free_note = (
+        "; the zero eigenvalues belong to the free coordinate(s), which stay where they are "
+        "put (a family of equilibria)"
+        if np.any(zero)
+        else ""
+    )
+    moving = lam[~zero]
+    if moving.size and np.all(moving.real < -tol) and not np.any(zero):
+        return (
+            "asymptotically stable",
+            f"every eigenvalue has negative real part ({shown}): damping makes every "
+            "small motion die out",
+            lam,
+            vecs,
+        )
+    if k_pd_off_free and c_psd:
+        reason = (
+            "K is positive definite, so the potential (V minus the centrifugal term where a "
+            "frame turns) has a minimum; velocity-linear terms cannot undo that (Thomson–Tait)"
+        )
+        if damped:
+            reason += ", and damping makes the motion decay"
+        return "stable", reason + f" (eigenvalues {shown}){free_note}", lam, vecs
+    on_axis = moving[np.abs(moving.real) <= tol]
+    semisimple = _semisimple(A, on_axis, scale)
+    if symmetric and gyroscopic and not damped and semisimple and moving.size == on_axis.size:
+        return (
+            "gyroscopically stable",
+            f"K is not positive definite (its eigenvalues {', '.join(f'{k:.4g}' for k in k_eigs)}"
+            "), but the gyroscopic (Coriolis) terms C keep every eigenvalue on the imaginary "
+            f"axis without repeated defective ones ({shown}): the linearized motion stays "
+            "bounded. Any damping would destroy this (Kelvin–Tait–Chetaev), and nonlinear terms "
+            "may too",
+            lam,
+            vecs,
+        )
+    if not semisimple:
+        why = "a repeated eigenvalue on the imaginary axis lacks a full set of eigenvectors"
+    elif not symmetric:
+        why = "K is not symmetric (forces at rest that are not from a potential)"
+    else:
+        why = "K is not positive definite and no gyroscopic term accounts for the stability"
+    return (
+        "marginal",
+        f"no eigenvalue has positive real part ({shown}), but {why}: the linear test cannot "
+        f"decide, nonlinear terms do{free_note}",
+        lam,
+        vecs,
+    )
+
+
+def _semisimple(A: np.ndarray, on_axis: np.ndarray, scale: float) -> bool:
+    """Each repeated eigenvalue on the axis has as many eigenvectors as its multiplicity."""
+    seen: list[complex] = []
+    for z in on_axis:
+        if any(abs(z - s) <= 1e-6 * scale for s in seen):
+            continue
+        seen.append(z)
+        multiplicity = int(np.sum(np.abs(on_axis - z) <= 1e-6 * scale))
+        if multiplicity == 1:
+            continue
+        s = np.linalg.svd(A - z * np.eye(len(A)), compute_uv=False)
+        if int(np.sum(s <= 1e-6 * scale)) < multiplicity:
+            return False
+    return True
+
+
+def _modes(M, C, K, lam, vecs, idx, n):
+    """ω from the imaginary parts of the eigenvalues, one per conjugate pair, ascending; modes
+    as displacement shapes (max |·| = 1). Without velocity terms they are real (K v = ω² M v);
+    with them a mode may whirl: its amplitudes and each coordinate's phase lag are given."""
+    size = len(idx)
+    scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
+    freqs, modes, phases = [], [], []
+
+    def spread(v):
+        mode = [0.0] * n
+        for j, x in zip(idx, v, strict=True):
+            mode[j] = float(x)
+        return mode
+
+    if not np.any(C):
+        import scipy.linalg
+
+        w2, vecs_r = scipy.linalg.eigh((K + K.T) / 2, M)
+        for i in np.argsort(w2):
+            if w2[i] <= 1e-9 * max(1.0, float(np.max(np.abs(w2)))):
+                continue
+            v = vecs_r[:, i] / np.max(np.abs(vecs_r[:, i]))
+            freqs.append(float(math.sqrt(w2[i])))
+            modes.append(spread(v))
+            phases.append([0.0] * n)
+        return freqs, modes, phases
+    picked = [i for i in range(len(lam)) if lam[i].imag > 1e-7 * scale]
+    for i in sorted(picked, key=lambda i: lam[i].imag):
+        v = vecs[:size, i]
+        k = int(np.argmax(np.abs(v)))
+        v = v * np.conj(v[k]) / abs(v[k]) / abs(v[k])
+        standing = np.max(np.abs(v.imag)) <= 1e-6
+        freqs.append(float(lam[i].imag))
+        if standing:
+            modes.append(spread(v.real))
+            phases.append([0.0] * n)
+        else:
+            modes.append(spread(np.abs(v)))
+            phases.append(spread(np.where(np.abs(v) > 1e-9, np.angle(v), 0.0)))
+    return freqs, modes, phases
+
+
+def _z(z: complex) -> str:
+    if abs(z.imag) <= 1e-12:
+        return f"{z.real:.4g}"
+    sign = "−" if z.imag < 0 else "+"
+    return f"{z.real:.4g} {sign} {abs(z.imag):.4g}i"
+
+
+def _eigen_text(lam: np.ndarray) -> str:
+    """λ, each conjugate pair once as a ± b i, and the imaginary-axis ones as ±b i."""
+    parts = []
+    for z in lam:
+        if z.imag < -1e-12:
+            continue
+        if abs(z.imag) <= 1e-12:
+            parts.append(f"{z.real:.4g}")
+        elif abs(z.real) <= 1e-9 * max(1.0, abs(z)):
+            parts.append(f"±{z.imag:.4g}i")
+        else:
+            parts.append(f"{z.real:.4g} ± {z.imag:.4g}i")
+    return ", ".join(parts)
+
+
+# --- the stability step ----------------------------------------------------------------------
 
 
 def _matrix(a: np.ndarray) -> str:
@@ -293,16 +814,26 @@ def _linear_latex(linear: dict) -> str:
     return f"{_matrix(linear['M'])}{dqdd}{damping} + {_matrix(linear['K'])}{dq} = 0"
 
 
-def _stability_step(d: Derivation, results: list[dict], linearized: list) -> Step:
+def _latex_text(s: str) -> str:
+    return "".join("\\" + c if c in "#$%&_{}" else c for c in s).replace("^", r"\^{}")
+
+
+def _stability_step(results: list[dict], verdicts: list[Verdict]) -> Step:
     text = (
         "About each equilibrium q₀ the motion linearizes to M δq̈ + C δq̇ + K δq = 0 with "
-        "K = −∂f/∂q and C = −∂f/∂q̇ at rest. It is stable when no mode grows; then "
-        "K v = ω² M v gives the small-oscillation frequencies and normal modes."
+        "K = −∂f/∂q and C = −∂f/∂q̇ at rest (C holds damping and the gyroscopic/Coriolis "
+        "terms of turning frames). With δq ∝ e^{λt} the eigenvalues λ of the first-order system "
+        "decide: any Re λ > 0 is unstable; all Re λ < 0 is asymptotically stable; K positive "
+        "definite is stable by the potential (Lagrange–Dirichlet), whatever C adds; K not "
+        "positive definite with every λ simple on the imaginary axis is gyroscopically stable "
+        "(only linearly: damping destroys it); what the linear test cannot decide is marginal. "
+        "The small-oscillation frequencies are the imaginary parts ω = Im λ."
     )
     lines = []
-    for r, linear in zip(results, linearized, strict=True):
-        q = ", ".join(f"{k} = {v:.4g}" for k, v in r["q"].items())
-        if linear is not None:
+    for r, v in zip(results, verdicts, strict=True):
+        q = ", ".join(f"{k} = {x:.4g}" for k, x in r["q"].items())
+        if v.linear is not None:
+            linear = v.linear
             lines.append(
                 Line(
                     f"linearized about {q}",
@@ -311,19 +842,14 @@ def _stability_step(d: Derivation, results: list[dict], linearized: list) -> Ste
                     f"K = {linear['K'].tolist()}",
                 )
             )
-        verdict = "stable" if r["stable"] else "unstable"
-        freqs = ", ".join(f"{f:.4g}" for f in r["frequencies"])
+        freqs = ", ".join(f"{f:.4g}" for f in v.frequencies)
+        omega = rf"\quad \omega = {freqs}\ \mathrm{{rad/s}}" if freqs else ""
         lines.append(
             Line(
                 q,
-                rf"\text{{{q}: {verdict}}}"
-                + (
-                    rf"\quad \omega = {freqs}\ "
-                    r"\mathrm{rad/s}"
-                    if freqs
-                    else ""
-                ),
-                f"{q}: {verdict} {freqs}",
+                rf"\text{{{_latex_text(q)}: {v.kind}}}{omega}"
+                rf"\\ \text{{because {_latex_text(v.reason)}}}",
+                f"{q}: {v.kind} {freqs}".rstrip() + f" — because {v.reason}",
             )
         )
     return Step("stability", "Stability and small oscillations", text, lines)

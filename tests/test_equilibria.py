@@ -31,6 +31,7 @@ def test_pendulum_hangs_stably_with_omega_squared_g_over_l():
     r = post(scene_id="simple_pendulum", parameters={"g": g, "l": length})
     down, up = at(r, theta=0.0), at(r, theta=math.pi)
     assert down["stable"] and not up["stable"]
+    assert (down["kind"], up["kind"]) == ("stable", "unstable")
     assert down["frequencies"] == pytest.approx([math.sqrt(g / length)], rel=1e-12)
     assert [s["id"] for s in r["steps"]] == ["virtual_work", "stability"]
 
@@ -38,7 +39,8 @@ def test_pendulum_hangs_stably_with_omega_squared_g_over_l():
 def test_coupled_oscillators_modes_k_over_m_and_3k_over_m():
     k, m = 4.0, 0.5
     r = post(scene_id="coupled_oscillators", parameters={"k": k, "k12": k, "m": m})
-    (e,) = r["equilibria"]
+    e = at(r, x1=0.0, x2=0.0)
+    assert e["kind"] == "stable"
     assert e["frequencies"] == pytest.approx([math.sqrt(k / m), math.sqrt(3 * k / m)], rel=1e-12)
     in_phase, out_of_phase = (np.array(v) for v in e["modes"])
     assert abs(in_phase[0] / in_phase[1] - 1) < 1e-12
@@ -82,6 +84,7 @@ def test_no_equilibrium_and_drives_are_explained():
     assert driven["equilibria"] == [] and "time" in driven["warnings"][0]
     undriven = post(scene_id="spring_mass_damper", parameters={"F0": 0.0})
     assert at(undriven, x=0.0)["stable"]
+    assert at(undriven, x=0.0)["kind"] == "asymptotically stable"
 
 
 def test_bad_parameters_are_422():
@@ -99,7 +102,29 @@ def test_the_linearized_equations_are_shown_with_their_matrices():
     """Coupled oscillators: M = m I, K = [[k + k12, −k12], [−k12, k + k12]], no damping."""
     k, k12, m = 4.0, 1.5, 0.5
     r = post(scene_id="coupled_oscillators", parameters={"k": k, "k12": k12, "m": m})
-    (line,) = [p for p in r["steps"][1]["plain"] if p.startswith("M = ")]
+    line = [p for p in r["steps"][1]["plain"] if p.startswith("M = ")][0]  # about x1 = x2 = 0
     assert f"M = {[[m, 0.0], [0.0, m]]}" in line
     assert f"K = {[[k + k12, -k12], [-k12, k + k12]]}" in line
     assert r"\delta \ddot" in r["steps"][1]["latex"][0]
+
+
+def test_coupled_oscillators_rest_wherever_the_spring_forces_balance_on_the_line():
+    """Springs along a line act on both sides of their anchors: V = Σ ½k(|Δx| − a)². Every listed
+    equilibrium makes ∂V/∂x vanish (checked here by finite differences), and none repeats."""
+    k, k12, m, a = 10.0, 1.0, 1.0, 1.0
+    r = post(scene_id="coupled_oscillators", parameters={"k": k, "k12": k12, "m": m, "a": a})
+
+    def V(x1, x2):
+        p1, p2 = a + x1, 2 * a + x2
+        return (
+            k * (abs(p1) - a) ** 2 + k12 * (abs(p2 - p1) - a) ** 2 + k * (abs(3 * a - p2) - a) ** 2
+        ) / 2
+
+    h = 1e-6
+    seen = set()
+    for e in r["equilibria"]:
+        x1, x2 = e["q"]["x1"], e["q"]["x2"]
+        assert abs(V(x1 + h, x2) - V(x1 - h, x2)) / (2 * h) < 1e-6
+        assert abs(V(x1, x2 + h) - V(x1, x2 - h)) / (2 * h) < 1e-6
+        seen.add((round(x1, 6), round(x2, 6)))
+    assert len(seen) == len(r["equilibria"]) >= 1

@@ -9,6 +9,15 @@ import { View } from "./view.js";
 
 const W = 150, H = 100;
 
+/** Each stability kind (the response's `kind`) in words. */
+const KIND_WORDS = {
+  "stable": "Stable: the potential has a minimum here",
+  "asymptotically stable": "Asymptotically stable: damping makes every small motion die out",
+  "gyroscopically stable": "Gyroscopically stable: not a minimum of the potential, but the Coriolis terms keep small motions bounded (any damping would undo it)",
+  "marginal": "Marginal: the linear test cannot decide, the nonlinear terms do",
+  "unstable": "Unstable: a small displacement grows",
+};
+
 /** A small drawing of the system resting at q (one zero-length run gives the positions). */
 async function sketch(svg, target, parameters, spec, q) {
   try {
@@ -39,9 +48,15 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       const li = document.createElement("li");
       const where = Object.entries(e.q).map(([k, v]) => `${k} = ${fmt(v)}`).join(", ");
       const closed = Object.entries(e.symbolic).map(([k, v]) => `${k} = ${v}`).join(", ");
-      li.innerHTML = `<div><span class="where"></span> <span class="tag ${e.stable ? "stable" : "unstable"}">${e.stable ? "stable" : "unstable"}</span></div>
-        <div class="muted closed"></div><div class="muted freq"></div><div class="buttons"></div>`;
+      const kind = e.kind || (e.stable ? "stable" : "unstable");
+      li.innerHTML = `<div><span class="where"></span> <span class="tag"></span></div>
+        <div class="muted closed"></div><div class="muted freq"></div><div class="muted why"></div><div class="buttons"></div>`;
       li.querySelector(".where").textContent = where;
+      const tag = li.querySelector(".tag");
+      tag.classList.add(e.stable ? "stable" : "unstable");
+      tag.textContent = kind;
+      tag.title = KIND_WORDS[kind] || "";
+      if (e.reason) li.querySelector(".why").textContent = `${KIND_WORDS[kind] || kind}: ${e.reason}.`;
       if (spec) {
         const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
         svg.setAttribute("class", "eq-sketch");
@@ -64,7 +79,11 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
         buttons.append(b);
       };
       button("start near", null);
-      e.modes.forEach((mode, k) => button(`excite mode ${k + 1}`, mode));
+      // A whirling mode (coordinates out of phase) is not a displacement pattern to start from.
+      e.modes.forEach((mode, k) => {
+        const phases = (e.mode_phases || [])[k] || [];
+        if (phases.every((p) => Math.abs(p) < 1e-9)) button(`excite mode ${k + 1}`, mode);
+      });
       ul.append(li);
     }
     box.replaceChildren(ul);
