@@ -21,8 +21,11 @@ from mechanics.spec import SpecError
 PROBES = 4
 
 
-def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> bool:
-    """Is M singular (or not positive definite) at every probed state, at these parameters?"""
+def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> list[int] | None:
+    """Is M singular (or not positive definite) at every probed state, at these parameters?
+
+    None when it is not; else the coordinates whose row of M vanishes at every probe (they move
+    no mass), possibly none."""
     n = M.shape[0]
     plain = {q: sp.Symbol(f"_q{i}") for i, q in enumerate(model.q)}
     velocities = {qd: sp.Symbol(f"_u{i}") for i, qd in enumerate(model.qd)}
@@ -32,6 +35,7 @@ def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> bool:
     f = sp.lambdify(args, exprs, modules="numpy")
     rng = random.Random(0)
     positive = set(model.spec.positive_coordinates)
+    idle = set(range(n))
     for _ in range(PROBES):
         q = [
             rng.uniform(0.5, 1.5) if name in positive else rng.uniform(-1.3, 1.3)
@@ -48,22 +52,34 @@ def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> bool:
             continue
         eig = np.linalg.eigvalsh((m + m.T) / 2)
         if eig.min() > 1e-14 * max(abs(eig).max(), 1e-300):
-            return False
-    return True
+            return None
+        idle &= {j for j in range(n) if not np.any(m[j])}
+    return sorted(idle)
 
 
 def check_mass_matrix(derivation) -> None:
     """Raise SpecError naming the parameters (or bodies) that leave M singular everywhere."""
     m, M = derivation.model, derivation.work.mass_matrix
     values = {k: float(v) for k, v in m.spec.parameters.items()}
-    if not singular_everywhere(M, m, values):
+    idle = singular_everywhere(M, m, values)
+    if idle is None:
         return
     used = {str(s) for s in M.free_symbols}
     culprits = [k for k, v in values.items() if k in used and v <= 0]
-    if culprits:
+    massless = [i for i, b in enumerate(m.bodies) if b.mass.is_zero]
+    if massless:
+        fields = ", ".join(f"bodies[{i}].mass" for i in massless)
+        message = "must be > 0: a massless body makes the mass matrix singular for every state"
+    elif culprits:
         fields = ", ".join(f"parameters.{k}" for k in culprits)
         said = ", ".join(f"{k} = {values[k]:g}" for k in culprits)
         message = f"must be > 0: with {said} the mass matrix is singular for every state"
+    elif idle:
+        fields = ", ".join(f"coordinates[{j}]" for j in idle)
+        message = (
+            f"{', '.join(m.coordinate_names[j] for j in idle)} moves no mass: it appears in no "
+            "body's position or orientation, so the mass matrix is singular for every state"
+        )
     else:
         fields = "bodies"
         message = (
