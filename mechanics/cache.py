@@ -5,10 +5,16 @@ So the engine keeps results here under a key that includes its version, and a re
 uvicorn worker) starts warm. The cache is an optimisation only: any failure to read or write it is
 logged and the caller simply computes the value again.
 
+An entry is verified on read, never trusted: it records the engine version and key it was written
+for, and the caller may pass a check of the value's shape. An entry from another version, for
+another key, of another shape, or not JSON at all is ignored (and recomputed by the caller).
+
     >>> key = key_for({"scene": "simple_pendulum"}, version="1")
-    >>> put(key, {"answer": 42})
-    >>> get(key)
+    >>> put(key, {"answer": 42}, version="1")
+    >>> get(key, version="1")
     {'answer': 42}
+    >>> get(key, version="2") is None
+    True
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ import json
 import logging
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -48,24 +55,41 @@ def key_for(obj: Any, version: str) -> str:
     return hashlib.sha256(f"{version}\n{canonical}".encode()).hexdigest()
 
 
-def get(key: str) -> dict | None:
-    """The value stored under ``key``, or None if absent or unreadable (never raises)."""
+def get(key: str, *, version: str, valid: Callable[[dict], bool] | None = None) -> dict | None:
+    """The value stored under ``key`` by engine ``version``, or None (never raises).
+
+    None too when the entry is unreadable, was written by another version or for another key,
+    or its value fails ``valid``: a stale or damaged entry is recomputed, never served.
+    """
     try:
         with _path(key).open(encoding="utf-8") as f:
-            value = json.load(f)
+            entry = json.load(f)
     except FileNotFoundError:
         return None
     except (OSError, ValueError) as exc:
         log.warning("cache: cannot read entry %s (%s); recomputing", key, exc)
         return None
-    if not isinstance(value, dict):
-        log.warning("cache: entry %s does not hold an object; recomputing", key)
+    if not (
+        isinstance(entry, dict)
+        and entry.get("engine") == version
+        and entry.get("key") == key
+        and isinstance(entry.get("value"), dict)
+    ):
+        log.warning("cache: entry %s is not one of engine %s; recomputing", key, version)
+        return None
+    value = entry["value"]
+    try:
+        ok = valid is None or bool(valid(value))
+    except Exception:  # a check that trips over a damaged value has answered: not valid
+        ok = False
+    if not ok:
+        log.warning("cache: entry %s does not have the expected shape; recomputing", key)
         return None
     return value
 
 
-def put(key: str, value: dict) -> None:
-    """Store ``value`` under ``key`` (never raises).
+def put(key: str, value: dict, *, version: str) -> None:
+    """Store ``value`` under ``key``, as computed by engine ``version`` (never raises).
 
     Written to a temporary file in the same folder and moved into place with ``os.replace``, which
     is atomic: a reader in another worker sees the old entry or the new one, never half a file.
@@ -76,7 +100,8 @@ def put(key: str, value: dict) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{key[:16]}.", suffix=".tmp")
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(value, f, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
+            entry = {"engine": version, "key": key, "value": value}
+            json.dump(entry, f, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
         os.replace(tmp, path)
         tmp = None
     except (OSError, TypeError, ValueError) as exc:

@@ -56,7 +56,7 @@ class Derivation:
     @functools.cached_property
     def solved_accelerations(self) -> list[Any]:
         """q̈: the simplified symbolic solution where the derivation has one, else M⁻¹f
-        (n > 3, or the time budget ran out). Checking answers and Newton's method both need it."""
+        (n > 3, or M and f past the size budget). Checking answers and Newton's method need it."""
         w = self.work
         if w.accelerations is not None:
             return list(w.accelerations)
@@ -103,7 +103,7 @@ def derive_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None)
     """
     start = time.perf_counter()
     model = build_model(spec, branches)
-    work = Work(started=start)
+    work = Work()
     token = unsimplified.set([])
     try:
         steps = [step(model, work) for step in STEPS]
@@ -139,9 +139,45 @@ def derive_scene(scene_id: str) -> dict[str, Any]:
         return _memory[scene_id]
     raw = load_scene(scene_id)  # KeyError for an unknown scene, before any work
     key = cache.key_for({"scene": raw}, ENGINE_VERSION)
-    result = cache.get(key)
+    result = cache.get(key, version=ENGINE_VERSION, valid=is_derivation_json)
     if result is None:
         result = derivation_of_scene(scene_id).to_json()
-        cache.put(key, json.loads(json.dumps(result)))
+        cache.put(key, json.loads(json.dumps(result)), version=ENGINE_VERSION)
     _memory[scene_id] = result
     return result
+
+
+def is_derivation_json(value: Any) -> bool:
+    """Has ``value`` the shape of ``Derivation.to_json()``? (a disk entry is checked before it is
+    served: one of another shape is recomputed, never passed on to the API)."""
+    if not isinstance(value, dict) or not _DERIVATION_KEYS <= set(value):
+        return False
+    steps, warnings = value["steps"], value["warnings"]
+    if not (isinstance(steps, list) and steps and isinstance(warnings, list)):
+        return False
+    if not all(isinstance(s, dict) and isinstance(s.get("id"), str) for s in steps):
+        return False
+    if not isinstance(value["scene"], dict):
+        return False
+    for equations in (value["equations"], value["latex"]):
+        if not isinstance(equations, dict) or not _EQUATION_KEYS <= set(equations):
+            return False
+        n = len(equations["eom"]) if isinstance(equations["eom"], dict) else -1
+        matrix, forcing = equations["mass_matrix"], equations["forcing"]
+        if n < 1 or not (isinstance(matrix, list) and len(matrix) == n):
+            return False
+        if not all(isinstance(row, list) and len(row) == n for row in matrix):
+            return False
+        if not (isinstance(forcing, list) and len(forcing) == n):
+            return False
+        acc = equations["accelerations"]
+        if acc is not None and not (isinstance(acc, dict) and len(acc) == n):
+            return False
+    return True
+
+
+_DERIVATION_KEYS = frozenset({"scene", "steps", "equations", "latex", "warnings", "seconds"})
+_EQUATION_KEYS = frozenset(
+    {"T", "V", "L", "generalized_forces", "eom", "mass_matrix", "forcing", "accelerations"}
+    | {"conserved"}
+)

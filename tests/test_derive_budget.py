@@ -39,3 +39,13 @@ def test_small_scenes_carry_no_simplification_warning():
         }
     )
     assert d.work.warnings == []
+
+
+def test_flags_do_not_depend_on_what_an_earlier_derivation_cached():
+    """The simplifier's caches are shared by every derivation in a process: a second derivation
+    of the same spec (every piece a cache hit) must flag exactly what the first one flagged."""
+    first = derive_model(SPEC)
+    second = derive_model(SPEC)
+    assert any("too large to simplify" in w for w in first.work.warnings)
+    assert second.work.warnings == first.work.warnings
+    assert second.to_json()["equations"] == first.to_json()["equations"]

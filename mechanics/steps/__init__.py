@@ -7,7 +7,6 @@ A step is a function ``(model, work) -> Step``: it reads the quantities earlier 
 from __future__ import annotations
 
 import functools
-import time
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Any
@@ -24,6 +23,12 @@ SIMPLIFY_OPS_BUDGET = 600
 SMALL_OPS = 16
 #: A sum of more terms than this is left as it is: no textbook prints one.
 MAX_TERMS = 100
+#: A sum past either size gets the trig pass group by group (see _large_sum): more terms than
+#: LARGE_TERMS, or more than LARGE_TERMS_X_SYMBOLS terms × free symbols (factor() works in every
+#: symbol at once). Every piece of the built-in scenes stays below both: they keep the whole-sum
+#: pass, whose forms are the hand-checked ones.
+LARGE_TERMS = 6
+LARGE_TERMS_X_SYMBOLS = 24
 
 
 #: Pieces left unsimplified because they were over budget, per derivation (per thread/task).
@@ -61,7 +66,11 @@ class Step:
 
 @dataclass
 class Work:
-    """What the steps have derived so far, and what could not be simplified in budget."""
+    """What the steps have derived so far, and what could not be simplified in budget.
+
+    No clock in here: every budget a step applies is a size (count_ops, terms, coordinates), so
+    the derivation is a function of the spec alone (only budget.py's outer deadline, which fails
+    a request, reads the clock)."""
 
     T: sp.Expr = sp.S.Zero
     V: sp.Expr = sp.S.Zero
@@ -75,7 +84,6 @@ class Work:
     accelerations: list[sp.Expr] | None = None
     conserved: list[dict[str, Any]] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
-    started: float = field(default_factory=time.perf_counter)
 
 
 def tidy(
@@ -92,10 +100,10 @@ def tidy(
     if expr.is_number:
         return sp.nsimplify(expr) if expr.is_Float else expr
     if model is None:
-        return _tidy_symbols(expr, (), factor_whole)
+        return _flagged(_tidy_symbols(expr, (), factor_whole))
     to_sym, back = _symbols_for(model)
     velocities = tuple(to_sym[v] for v in (*model.qdd, *model.qd)) if collect_velocities else ()
-    return _tidy_symbols(expr.xreplace(to_sym), velocities, factor_whole).xreplace(back)
+    return _flagged(_tidy_symbols(expr.xreplace(to_sym), velocities, factor_whole)).xreplace(back)
 
 
 def partial(expr: sp.Expr, var: sp.Expr, model: Any) -> sp.Expr:
@@ -135,25 +143,42 @@ def _symbols_for(model: Any) -> tuple[dict, dict]:
     return cached
 
 
+#: What a cached simplification returns: the expression, and the pieces it left unsimplified.
+Tidied = tuple[sp.Expr, tuple[sp.Expr, ...]]
+
+
 @functools.lru_cache(maxsize=4096)
-def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -> sp.Expr:
+def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -> Tidied:
+    """tidy() on plain symbols. Cached across derivations, so it returns the pieces it left
+    unsimplified instead of reporting them: a cache hit must flag exactly what a miss flags."""
     e = sp.expand(expr)
     if e == 0:
-        return e
+        return e, ()
     if e.is_Add and len(e.args) > MAX_TERMS:
-        _flag(e)  # far past the budget: even grouping it costs more than it can gain
-        return e
+        return e, (e,)  # far past the budget: even grouping it costs more than it can gain
     if velocities:
         groups = sp.collect(e, velocities, evaluate=False)
         if len(groups) > 1 or 1 not in groups:
-            total = sp.Add(*(_trig_pass(c) * m for m, c in groups.items()))
-            return min((total, sp.factor_terms(total)), key=_size) if factor_whole else total
+            passes = [(_trig_pass(c), m) for m, c in groups.items()]
+            total = sp.Add(*(c * m for (c, _), m in passes))
+            skipped = tuple(p for (_, flags), _ in passes for p in flags)
+            if factor_whole:
+                total = min((total, sp.factor_terms(total)), key=_size)
+            return total, skipped
     return _trig_pass(e)
+
+
+def _flagged(tidied: Tidied) -> sp.Expr:
+    """Report the pieces a (possibly cached) simplification left alone; return its result."""
+    expr, skipped = tidied
+    for piece in skipped:
+        _flag(piece)
+    return expr
 
 
 def _flag(e: sp.Expr) -> None:
     skipped = unsimplified.get(None)
-    if skipped is not None:
+    if skipped is not None and e not in skipped:  # a piece counts once, however often it recurs
         skipped.append(e)
 
 
@@ -177,12 +202,71 @@ def _size(e: sp.Expr) -> tuple[int, int]:
     return sp.count_ops(e), sum(1 for _ in sp.preorder_traversal(e))
 
 
-def _trig_pass(c: sp.Expr) -> sp.Expr:
-    """sin²+cos² = 1 and products to sums of angles, keeping whichever form is smallest."""
+@functools.lru_cache(maxsize=4096)
+def _trig_pass(c: sp.Expr) -> Tidied:
+    """sin²+cos² = 1 and products to sums of angles, keeping whichever form is smallest.
+
+    Cached: T, L, E and the Jacobi integral share most of their coefficients. A piece over the
+    size budget comes back as it is, and as skipped (see _tidy_symbols)."""
     c = sp.expand(c)
     if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
-        _flag(c)
-        return c
+        return c, (c,)
+    if c.is_Add and _is_large(c):
+        return _large_sum(c)
+    return _trig_identities(c), ()
+
+
+def _is_large(c: sp.Add) -> bool:
+    terms = len(c.args)
+    return terms > LARGE_TERMS or terms * len(c.free_symbols) > LARGE_TERMS_X_SYMBOLS
+
+
+def _large_sum(c: sp.Add) -> Tidied:
+    """The trig pass of a sum of many terms (a chain of 3+ links), in two small passes.
+
+    On the whole sum TR10i tries every pair of terms and factor() works in every symbol at once:
+    seconds per piece. But an identity only ever joins terms with the same trig-free coefficient
+    (m l² sin² + m l² cos² = m l²), so each coefficient's trig part is simplified alone; then the
+    terms with the same trig part are gathered and their trig-free coefficient factored:
+    l1 m2 cos θ1 + l1 m3 cos θ1 → l1 (m2 + m3) cos θ1.
+    """
+    by_coefficient: dict[sp.Expr, list[sp.Expr]] = {}
+    for term in c.args:
+        coefficient, trig = _split_trig(term, numbers_with_trig=True)
+        by_coefficient.setdefault(coefficient, []).append(trig)
+    passes = [(k, _trig_group(sp.Add(*trigs))) for k, trigs in by_coefficient.items()]
+    skipped = tuple(p for _, (_, flags) in passes for p in flags)
+    by_trig: dict[sp.Expr, list[sp.Expr]] = {}
+    for term in sp.Add.make_args(sp.expand(sp.Add(*(k * e for k, (e, _) in passes)))):
+        coefficient, trig = _split_trig(term)
+        by_trig.setdefault(trig, []).append(coefficient)
+    total = sp.Add(*(sp.factor(sp.Add(*ks)) * trig for trig, ks in by_trig.items()))
+    return _positive_lead(sp.factor_terms(total)), skipped
+
+
+@functools.lru_cache(maxsize=4096)
+def _trig_group(c: sp.Expr) -> Tidied:
+    """The whole-sum pass on one group of _large_sum (never split again: its terms share one
+    coefficient already)."""
+    if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
+        return c, (c,)
+    return _trig_identities(c), ()
+
+
+def _split_trig(term: sp.Expr, numbers_with_trig: bool = False) -> tuple[sp.Expr, sp.Expr]:
+    """A product as (trig-free coefficient, the factors with a function in them).
+
+    With ``numbers_with_trig`` the number goes with the trig part, so that m² cos²a,
+    −2 m² cos a cos b and m² fall in one group, where sums like 1 − cos²a can cancel."""
+    coefficient, trig = [], []
+    for f in sp.Mul.make_args(term):
+        goes_with_trig = f.has(sp.Function) or (numbers_with_trig and f.is_Number)
+        (trig if goes_with_trig else coefficient).append(f)
+    return sp.Mul(*coefficient), sp.Mul(*trig)
+
+
+def _trig_identities(c: sp.Expr) -> sp.Expr:
+    """The whole-sum trig pass proper, on a piece within the size budget."""
     if c.has(sp.tan, sp.cot, sp.sec, sp.csc) and sp.count_ops(c) <= SMALL_OPS:
         c = min((c, sp.trigsimp(c)), key=_size)  # small: trigsimp is cheap here
     if c.has(sp.sin, sp.cos):
