@@ -394,12 +394,32 @@ class StopWatch:
         return False
 
     def secant(self, params: list[float]) -> tuple[Any, float, np.ndarray]:
-        """Where the line through the last two values meets 0, one Euler step from the last."""
+        """Where the line through the last two values meets 0, and the state there.
+
+        The state comes from integrating to that moment from the side the motion arrives on
+        (before a crossing; after a creep or a bounce, which never crossed), where the equations
+        are smooth: stepping from a state past a discontinuity would carry its other side's
+        acceleration back (a block reported sticking while still moving).
+        """
         i, t0, y0, t1, y1, _ = self.hit
         v0, v1 = self._values(t0, y0)[i], self._values(t1, y1)[i]
         t_stop = t1 if v0 == v1 else t1 + v1 * (t1 - t0) / (v0 - v1)
         t_stop = min(max(t_stop, t0), t1 + (t1 - t0))
-        return self.c.stops[i], t_stop, y1 + (t_stop - t1) * self.c.rhs(params)(t1, y1)
+        crossed = np.sign(v0) != np.sign(v1)
+        start, state = (t0, y0) if crossed or t_stop < t1 else (t1, y1)
+        return self.c.stops[i], t_stop, _advance(self.c, params, start, state, t_stop)
+
+
+def _advance(c: CompiledScene, params: list[float], t0: float, y0: np.ndarray, t1: float):
+    """The state at t1 from (t0, y0) on a smooth stretch, tightly; y0 itself if that fails."""
+    if t1 == t0:
+        return np.array(y0, dtype=float)
+    try:
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(c.rhs(params), (t0, t1), y0, method="DOP853", rtol=1e-12, atol=1e-12)
+    except _PHYSICAL:
+        return np.array(y0, dtype=float)
+    return sol.y[:, -1] if sol.success else np.array(y0, dtype=float)
 
 
 def _watch(c: CompiledScene, params: list[float], y0: np.ndarray) -> StopWatch | None:
