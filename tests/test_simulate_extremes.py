@@ -387,6 +387,15 @@ def test_spherical_pendulum_started_on_the_pole_is_refused_with_the_reason():
     assert "singular" in error["message"]
 
 
+def test_a_zero_length_run_at_the_pole_places_the_bob_without_moving_it():
+    """The equilibrium sketches ask for positions only (t_end = 0): at the pole that is fine."""
+    r = spherical({"theta": 0.0, "theta_dot": 0.0, "phi": 0.0, "phi_dot": 0.0}, t_end=0.0)
+    assert r["t"] == [0.0]
+    assert r["positions"]["bob"]["y"] == [
+        pytest.approx(-load_scene("spherical_pendulum")["parameters"]["l"])
+    ]
+
+
 def test_spherical_pendulum_started_near_the_pole_warns_of_the_coordinate_singularity():
     r = spherical({"theta": 1e-6, "theta_dot": 1.0, "phi": 0.0, "phi_dot": 0.0}, t_end=1.0)
     assert all_finite(r)
