@@ -4,13 +4,21 @@ Side by side in one process, per built-in scene: the engine's cold derivation (e
 simplified), its warm answer over HTTP, and sympy's LagrangesMethod followed by simplify() of the
 mass matrix and forcing on the same system — the baseline a careful student would write. Ratios
 rather than absolute times, because the machine's speed drifts.
+
+Then three systems larger than any built-in scene (a triple pendulum, a heavy symmetric top through
+three Euler rotations, a six-link chain), each derived cold: a fresh process with an empty cache,
+the way a posted scene is first derived. Wall and CPU seconds, median of a few runs.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 
 import sympy as sp
@@ -19,6 +27,109 @@ from sympy.core.cache import clear_cache
 from mechanics import oracle
 from mechanics.derive import derivation_of_scene
 from mechanics.scenes import scene_ids
+
+
+def chain_spec(n: int) -> dict:
+    """n bobs on n rods, each angle measured from the downward vertical (absolute angles)."""
+    bodies = []
+    for i in range(1, n + 1):
+        components = [f"l{i}*sin(theta{i})", f"-l{i}*cos(theta{i})", 0]
+        position = (
+            components
+            if i == 1
+            else {"frame": "N", "components": components, "from": f"bob{i - 1}"}
+        )
+        bodies.append({"name": f"bob{i}", "mass": f"m{i}", "position": position})
+    parameters = {"g": 9.81} | {f"{p}{i}": 1.0 for i in range(1, n + 1) for p in ("m", "l")}
+    return {
+        "title": f"{n}-link chain",
+        "coordinates": [f"theta{i}" for i in range(1, n + 1)],
+        "parameters": parameters,
+        "bodies": bodies,
+        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    }
+
+
+#: A heavy symmetric top: frames z by psi, x by theta, z by phi; inertia A, A, C about its centre
+#: of mass, which sits l along the body axis from the fixed point O.
+HEAVY_TOP = {
+    "title": "Heavy symmetric top",
+    "coordinates": ["psi", "theta", "phi"],
+    "parameters": {"m": 1.0, "A": 1.0, "C": 0.5, "l": 1.0, "g": 9.81},
+    "frames": [
+        {"name": "P", "parent": "N", "axis": "z", "angle": "psi"},
+        {"name": "Q", "parent": "P", "axis": "x", "angle": "theta"},
+        {"name": "B", "parent": "Q", "axis": "z", "angle": "phi"},
+    ],
+    "bodies": [
+        {
+            "name": "top",
+            "kind": "rigid_body",
+            "mass": "m",
+            "frame": "B",
+            "position": {"frame": "B", "components": [0, 0, "l"]},
+            "inertia": {"ixx": "A", "iyy": "A", "izz": "C"},
+        }
+    ],
+    "gravity": {"acceleration": "g", "direction": [0, 0, -1]},
+}
+
+#: Systems past the built-in catalog, derived cold by `bench_systems` (and checked against
+#: LagrangesMethod in tests/test_determinism.py).
+SYSTEMS = {
+    "triple_pendulum": chain_spec(3),
+    "heavy_top": HEAVY_TOP,
+    "six_link_chain": chain_spec(6),
+}
+
+#: One cold derivation in a fresh process: prints import and derive seconds (wall, CPU) as JSON.
+_COLD_CHILD = """
+import json, sys, time
+w0, c0 = time.perf_counter(), time.process_time()
+from mechanics.derive import derive
+w1, c1 = time.perf_counter(), time.process_time()
+out = derive(json.loads(sys.argv[1]))
+w2, c2 = time.perf_counter(), time.process_time()
+print(json.dumps({"import_s": w1 - w0, "derive_s": w2 - w1, "derive_cpu_s": c2 - c1,
+                  "total_s": w2 - w0, "solved": out["equations"]["accelerations"] is not None}))
+"""
+
+
+def bench_systems(names: list[str], runs: int = 3) -> list[dict]:
+    """Cold derive cost of each named system: fresh process, empty cache, median of ``runs``."""
+    rows = []
+    for name in names:
+        samples = []
+        for _ in range(runs):
+            with tempfile.TemporaryDirectory(prefix="lagrange-lab-bench-") as empty:
+                env = os.environ | {"LAGRANGE_LAB_CACHE": empty}
+                done = subprocess.run(
+                    [sys.executable, "-c", _COLD_CHILD, json.dumps(SYSTEMS[name])],
+                    env=env,
+                    capture_output=True,
+                    text=True,
+                    check=True,
+                )
+            samples.append(json.loads(done.stdout))
+        row = {"system": name, "solved": samples[0]["solved"]}
+        for key in ("import_s", "derive_s", "derive_cpu_s", "total_s"):
+            row[key] = statistics.median(s[key] for s in samples)
+        rows.append(row)
+    return rows
+
+
+def print_systems(rows: list[dict]) -> None:
+    head = (
+        f"{'system (cold, fresh process)':<30} {'import s':>8} {'derive s':>8} {'CPU s':>6} "
+        f"{'total s':>7}  q̈ solved"
+    )
+    print(head)
+    print("-" * len(head))
+    for r in rows:
+        print(
+            f"{r['system']:<30} {r['import_s']:8.2f} {r['derive_s']:8.2f} "
+            f"{r['derive_cpu_s']:6.2f} {r['total_s']:7.2f}  {'yes' if r['solved'] else 'no'}"
+        )
 
 
 def _size(exprs) -> int:
@@ -133,14 +244,24 @@ def print_derive(rows: list[dict]) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m mechanics.bench")
     sub = parser.add_subparsers(dest="what", required=True)
-    d = sub.add_parser("derive", help="derivation cost per built-in scene vs sympy")
-    d.add_argument("scenes", nargs="*", help="scene ids (default: all)")
+    d = sub.add_parser(
+        "derive", help="derivation cost per built-in scene vs sympy, then larger systems cold"
+    )
+    d.add_argument(
+        "scenes", nargs="*", help=f"scene ids and/or {', '.join(SYSTEMS)} (default: all)"
+    )
     i = sub.add_parser("integrate", help="work-precision table of the integrators vs a baseline")
     i.add_argument("scenes", nargs="*", help="scene ids of the problems to run (default: all)")
     i.add_argument("--html", default="work-precision.html", help="where to write the diagram")
     args = parser.parse_args(argv)
     if args.what == "derive":
-        print_derive(bench_derive(args.scenes or scene_ids()))
+        scenes = [s for s in args.scenes if s not in SYSTEMS] if args.scenes else scene_ids()
+        systems = [s for s in args.scenes if s in SYSTEMS] if args.scenes else list(SYSTEMS)
+        if scenes:
+            print_derive(bench_derive(scenes))
+        if systems:
+            print("\n" if scenes else "", end="")
+            print_systems(bench_systems(systems))
     else:
         from mechanics.bench_integrate import main as integrate_main
 

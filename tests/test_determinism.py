@@ -30,54 +30,13 @@ from sympy.physics.mechanics import (
 )
 
 from mechanics import cache, derive
+from mechanics.bench import SYSTEMS
 from mechanics.derive import ENGINE_VERSION, derive_model, derive_scene, is_derivation_json
 from mechanics.scenes import load_scene
 
-
-def chain(n: int) -> dict:
-    """n bobs on n rods, each angle measured from the downward vertical (absolute angles)."""
-    bodies = []
-    for i in range(1, n + 1):
-        components = [f"l{i}*sin(theta{i})", f"-l{i}*cos(theta{i})", 0]
-        position = (
-            components
-            if i == 1
-            else {"frame": "N", "components": components, "from": f"bob{i - 1}"}
-        )
-        bodies.append({"name": f"bob{i}", "mass": f"m{i}", "position": position})
-    parameters = {"g": 9.81} | {f"{p}{i}": 1.0 for i in range(1, n + 1) for p in ("m", "l")}
-    return {
-        "title": f"{n}-link chain",
-        "coordinates": [f"theta{i}" for i in range(1, n + 1)],
-        "parameters": parameters,
-        "bodies": bodies,
-        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-    }
-
-
-TRIPLE_PENDULUM = chain(3)
-HEAVY_TOP = {
-    "title": "Heavy symmetric top",
-    "coordinates": ["psi", "theta", "phi"],
-    "parameters": {"m": 1.0, "A": 1.0, "C": 0.5, "l": 1.0, "g": 9.81},
-    "frames": [
-        {"name": "P", "parent": "N", "axis": "z", "angle": "psi"},
-        {"name": "Q", "parent": "P", "axis": "x", "angle": "theta"},
-        {"name": "B", "parent": "Q", "axis": "z", "angle": "phi"},
-    ],
-    "bodies": [
-        {
-            "name": "top",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "B",
-            "position": {"frame": "B", "components": [0, 0, "l"]},
-            "inertia": {"ixx": "A", "iyy": "A", "izz": "C"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, 0, -1]},
-}
-SIX_LINK_CHAIN = chain(6)
+TRIPLE_PENDULUM = SYSTEMS["triple_pendulum"]
+HEAVY_TOP = SYSTEMS["heavy_top"]
+SIX_LINK_CHAIN = SYSTEMS["six_link_chain"]
 
 
 # --- the clock cannot change a derivation ---------------------------------------------------

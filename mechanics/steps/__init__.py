@@ -250,7 +250,7 @@ def _trig_group(c: sp.Expr) -> Tidied:
     coefficient already)."""
     if sp.count_ops(c) > SIMPLIFY_OPS_BUDGET:
         return c, (c,)
-    return _trig_identities(c), ()
+    return _trig_forms(c), ()
 
 
 def _split_trig(term: sp.Expr, numbers_with_trig: bool = False) -> tuple[sp.Expr, sp.Expr]:
@@ -274,6 +274,23 @@ def _trig_identities(c: sp.Expr) -> sp.Expr:
         candidates += [sp.expand(TR10i(x)) for x in candidates]
         candidates += [sp.expand(TR8(c)), sp.expand(sp.expand_trig(c))]
         c = TR10i(min(candidates, key=_size))
+    return _factored(c)
+
+
+def _trig_forms(c: sp.Expr) -> sp.Expr:
+    """The trig pass of one group of _large_sum, expanded (the caller gathers and factors).
+
+    Fewer forms than the whole-sum pass: on the groups of a triple pendulum, a heavy top and a
+    six-link chain the smallest form was always c itself, TR6, TR10i or TR8 (products to sums)."""
+    if not c.has(sp.sin, sp.cos):
+        return c
+    candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
+    candidates += [sp.expand(TR10i(c)), sp.expand(TR8(c))]
+    return sp.expand(TR10i(min(candidates, key=_size)))
+
+
+def _factored(c: sp.Expr) -> sp.Expr:
+    """A sum with its common factors out, and a minus sign moved into it where that reads better."""
     if not c.is_Add:
         return c
     if len(c.args) < 3:  # a common factor of two terms is all there is to find

@@ -24,7 +24,7 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
     residual = [lhs - Q for lhs, Q in zip(work.eom_lhs, work.Q, strict=True)]
     M = sp.Matrix(n, n, lambda j, k: tidy(partial(residual[j], model.qdd[k], model), model))
     zero = dict.fromkeys(model.qdd, 0)
-    f = sp.Matrix([tidy(-r.subs(zero), model) for r in residual])
+    f = sp.Matrix([tidy(-r.xreplace(zero), model) for r in residual])  # q̈ as it is, no chain rule
     work.mass_matrix, work.forcing = M, f
     lines = [
         Line("M", rf"\mathbf{{M}} = {to_latex(M)}", f"M = {to_plain(M.tolist())}"),
