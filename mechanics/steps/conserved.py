@@ -16,7 +16,7 @@ def explicit_time(expr: sp.Expr, model: Model) -> bool:
     for group in (model.qdd, model.qd, model.q):
         for i, s in enumerate(group):
             dummies[s] = sp.Dummy(f"d{i}")
-    return expr.subs(dummies).has(t)
+    return expr.xreplace(dummies).has(t)
 
 
 def conserved_quantities(model: Model, work: Work) -> Step:

@@ -66,7 +66,7 @@ class _Sampler:
     def values(self, v: Vector) -> list[list[float]]:
         N = self.model.N
         comps = [v.dot(u) for u in (N.x, N.y, N.z)]
-        return [[float(c.subs(s)) for c in comps] for s in self.states]
+        return [[float(c.xreplace(s)) for c in comps] for s in self.states]
 
     def zero(self, v: Vector) -> bool:
         return all(abs(x) <= ZERO for row in self.values(v) for x in row)
