@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import ast
 import difflib
+import functools
 import keyword
 import math
 import operator
@@ -393,6 +394,13 @@ def to_plain(expr: sp.Expr | list) -> str:
     """Plain text in the input convention, so a result can be pasted back into an input field."""
     if isinstance(expr, list):
         return "[" + ", ".join(to_plain(e) for e in expr) + "]"
+    if isinstance(expr, sp.Basic):
+        return _plain_memo(expr)  # a derivation prints each quantity in its step and its summary
+    return _PLAIN.doprint(expr)
+
+
+@functools.lru_cache(maxsize=4096)
+def _plain_memo(expr: sp.Basic) -> str:
     return _PLAIN.doprint(expr)
 
 
@@ -402,4 +410,11 @@ def to_latex(expr: sp.Expr) -> str:
     vlatex (not sympy.latex) because it drops the (t) of coordinates and draws q' as a dot;
     it accepts physics.vector Vectors and matrices too.
     """
+    if isinstance(expr, sp.Expr):
+        return _latex_memo(expr)
+    return vlatex(expr)
+
+
+@functools.lru_cache(maxsize=4096)
+def _latex_memo(expr: sp.Expr) -> str:
     return vlatex(expr)
