@@ -7,8 +7,11 @@ a laptop, and production runs the same command with ``--host 0.0.0.0 --workers N
 from __future__ import annotations
 
 import argparse
+from functools import partial
 
 import uvicorn
+
+from app.server import HEADER_TIMEOUT, HeaderDeadlineProtocol
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -22,6 +25,19 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--port", type=int, default=8000, help="port to bind (default 8000)")
     serve.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
     serve.add_argument("--reload", action="store_true", help="restart when a source file changes")
+    serve.add_argument(
+        "--timeout-keep-alive",
+        type=float,
+        default=5,
+        help="close an idle kept-alive connection after this many seconds (default 5)",
+    )
+    serve.add_argument(
+        "--timeout-headers",
+        type=float,
+        default=HEADER_TIMEOUT,
+        help="close a connection whose request headers take longer than this "
+        f"(default {HEADER_TIMEOUT:g} s)",
+    )
     return parser
 
 
@@ -37,6 +53,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.reload and args.workers > 1:
         parser.error("--reload runs a single worker; drop --workers")
     uvicorn.run(
-        "app.main:app", host=args.host, port=args.port, workers=args.workers, reload=args.reload
+        "app.main:app",
+        host=args.host,
+        port=args.port,
+        workers=args.workers,
+        reload=args.reload,
+        http=partial(HeaderDeadlineProtocol, header_timeout=args.timeout_headers),
+        timeout_keep_alive=args.timeout_keep_alive,
     )
     return 0

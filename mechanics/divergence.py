@@ -117,6 +117,8 @@ def best_time_shift(t: np.ndarray, q: np.ndarray, q_other: np.ndarray) -> TimeSh
     reach = min(reach, MAX_SHIFT, 0.25 * duration)
     last = np.nonzero((t >= t[-1] - stretch - reach) & (t <= t[-1] - reach))[0]
     last = last[:: max(1, len(last) // MAX_FIT_POINTS)]
+    if not len(last):  # a run of a few samples: no stretch before the shift's reach to match
+        return TimeShift(0.0, 0.0)
     before = float(np.max(np.abs(q[last] - q_other[last])))
     if before == 0.0:
         return TimeShift(0.0, 0.0)

@@ -33,6 +33,7 @@ import sympy as sp
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import T as t
+from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
 from mechanics.steps import Line, Step, tidy
 from mechanics.steps.conserved import explicit_time
@@ -119,7 +120,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = [], []
     for variant, root in found:
         q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
-        verdict = _stability(variant, q0, free, values)
+        try:
+            with np.errstate(all="ignore"):
+                verdict = _stability(variant, q0, free, values)
+        except (_BeyondDoubles, np.linalg.LinAlgError, OverflowError) as exc:
+            raise _beyond_doubles(d, parameters or {}, q0, exc) from None
+        except ValueError:  # sympy cannot differentiate the forces here: sign(q̇) at q̇ = 0
+            verdict = Verdict("marginal", _NOT_SMOOTH, [], [], [], [], None)
+            if _NOT_SMOOTH_WARNING not in warnings:
+                warnings.append(_NOT_SMOOTH_WARNING)
         verdicts.append(verdict)
         results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
@@ -128,6 +137,33 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     if not results:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+_NOT_SMOOTH = (
+    "the forces are not differentiable at rest (a sign(q̇) of Coulomb friction, say), so there "
+    "is no linearization: the linear test cannot decide"
+)
+_NOT_SMOOTH_WARNING = (
+    "Stability is undecided where the forces are not smooth at rest (dry friction): "
+    "those equilibria are listed as marginal."
+)
+
+
+class _BeyondDoubles(ArithmeticError):
+    """The linearization at an equilibrium is not finite in double precision."""
+
+
+def _beyond_doubles(d: Derivation, parameters: dict, q0: list[float], exc: Exception) -> SpecError:
+    """A 422 naming the parameters whose size broke the linearization (m₂ = 1e265 beside
+    m₁ = 1 makes M singular to double precision; Ω = 1e308 makes K infinite)."""
+    m = d.model
+    values = {f"parameters.{k}": float(v) for k, v in _checked(d, parameters).items()}
+    at = ", ".join(f"{q} = {v:.4g}" for q, v in zip(m.coordinate_names, q0, strict=True))
+    what = "the linearization M δq̈ + C δq̇ + K δq = 0 overflows double precision"
+    if isinstance(exc, np.linalg.LinAlgError):
+        what = "the mass matrix is singular to double precision"
+    error = overflow_error(values, [f"parameters.{k}" for k in parameters], f"{what} at {at}")
+    return SpecError([error])
 
 
 def _result_json(m: Any, root: Root, free: list[int], v: Verdict, q0: list[float]) -> dict:
@@ -619,6 +655,8 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
     K = np.array([[-num(fj.diff(m.q[k])) for k in idx] for fj in f])
     C = np.array([[-num(fj.diff(m.qd[k])) for k in idx] for fj in f])
     M = full_M[np.ix_(idx, idx)]
+    if not all(np.all(np.isfinite(x)) for x in (M, C, K)):
+        raise _BeyondDoubles
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
     n_free = len([j for j in free if j in idx])
     kind, reason, lam, vecs = _classify(M, C, K, n_free, [m.coordinate_names[j] for j in idx])

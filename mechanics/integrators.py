@@ -16,7 +16,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import integrate as si
 
 from mechanics import native as native_code
 from mechanics.native import NativeRhs
@@ -77,7 +76,13 @@ METHODS: dict[str, MethodInfo] = {
 }
 # fmt: on
 
-_SCIPY = {"RK45": si.RK45, "DOP853": si.DOP853, "Radau": si.Radau, "BDF": si.BDF, "LSODA": si.LSODA}
+
+def _scipy_solver(name: str) -> type:
+    """scipy's stepper class by name, imported on first use: the registry above is read by the
+    API's schemas at startup, and scipy.integrate costs 0.4 s to import."""
+    from scipy import integrate as si
+
+    return getattr(si, name)
 
 
 @dataclass
@@ -94,6 +99,12 @@ class Trajectory:
     wall_time: float  # seconds
     note: str = ""  # how the method ran, when not as named (e.g. no C compiler: scipy's DOP853)
 
+    def __post_init__(self) -> None:
+        # Counters reach the JSON of a response: plain Python numbers, whatever counted them
+        # (LSODA's njev is a numpy int32, the C loop's counts come through ctypes).
+        self.nfev, self.nsteps, self.njev = int(self.nfev), int(self.nsteps), int(self.njev)
+        self.wall_time = float(self.wall_time)
+
 
 class _Stop(Exception):
     """Ends a run early; the message says why and when."""
@@ -106,6 +117,13 @@ _PHYSICAL = (ArithmeticError, np.linalg.LinAlgError)
 
 def _physical_stop(exc: BaseException, t: float) -> str:
     return f"{type(exc).__name__} near t = {t:.6g} s: {exc}"
+
+
+def _beyond_doubles(exc: BaseException) -> bool:
+    """Did numpy/scipy refuse numbers past the range of a double (an implicit method's Jacobian
+    of finite differences overflows for m = 1e-215 while q̈ stays finite)?"""
+    text = str(exc)
+    return isinstance(exc, np.linalg.LinAlgError) or "infs or NaNs" in text
 
 
 def _finite(v: np.ndarray) -> bool:
@@ -231,7 +249,7 @@ def integrate(
             elif method == "dop853_fortran":
                 _fortran(run, f, y0, t_eval, rtol, atol, max_steps)
             else:
-                _adaptive(run, _SCIPY[method], f, y0, t_eval, rtol, atol, max_steps)
+                _adaptive(run, _scipy_solver(method), f, y0, t_eval, rtol, atol, max_steps)
     except _Stop as stop:
         status, message = "stopped", str(stop)
     except _PHYSICAL as exc:
@@ -328,11 +346,12 @@ def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) ->
         t_before = solver.t
         try:
             message = solver.step()
-        except (ValueError, np.linalg.LinAlgError):  # e.g. the LU of a NaN Jacobian
-            if f.bad_t is None:
+        except (ValueError, np.linalg.LinAlgError) as exc:  # e.g. the LU of a NaN Jacobian
+            if f.bad_t is None and not _beyond_doubles(exc):
                 raise
             solver.status = "failed"
-        run.njev = solver.njev
+            message = "the Jacobian is not finite (its entries overflow double precision)"
+        run.njev = int(solver.njev)  # LSODA counts in a numpy int32
         if solver.t == t_before and solver.status == "running":
             # LSODA at a blow-up reports "running" steps of size 0 (t stuck, y drifting) until a
             # budget runs out: no progress is a failure, blamed on a non-finite RHS if there was one
@@ -376,6 +395,8 @@ def _fortran(run: _Run, f: _Counted, y0, t_eval, rtol, atol, max_steps) -> None:
         if f.failure is None and f.watched(t, y):
             f.failure = _Stop(f"a stop condition was reached near t = {t:.6g} s")
         return -1 if f.failure is not None or not _finite(y) else 0
+
+    from scipy import integrate as si
 
     solver = si.ode(f).set_integrator("dop853", rtol=rtol, atol=atol, nsteps=max_steps)
     solver.set_solout(solout)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import json
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -304,7 +305,33 @@ def compiled_spec(spec: dict, branches: Branches = ()) -> CompiledScene:
     return _compiled_spec(json.dumps(spec, sort_keys=True), branches)
 
 
+#: Past 1e±30 a value is more likely a units mistake than physics: such values are named first
+#: when a scene's numbers overflow double precision.
+EXTREME_EXPONENT = 30
+
+
+def overflow_error(values: dict[str, float], fallback: list[str], what: str) -> dict[str, str]:
+    """The 422 entry for numbers past double precision (``what`` says what broke, verb included):
+    names the values (keyed by field path) farthest from 1 in order of magnitude, or the
+    ``fallback`` fields when none is extreme."""
+    far = [
+        (k, v) for k, v in values.items() if v != 0 and abs(math.log10(abs(v))) > EXTREME_EXPONENT
+    ]
+    far.sort(key=lambda kv: -abs(math.log10(abs(kv[1]))))
+    advice = "pick units in which the numbers are nearer 1"
+    if not far:
+        return {"field": ", ".join(fallback) or "parameters", "message": f"{what}: {advice}"}
+    named = ", ".join(f"{k.rsplit('.', 1)[-1]} = {v:g}" for k, v in far)
+    return {"field": ", ".join(k for k, _ in far), "message": f"with {named}, {what}: {advice}"}
+
+
 def evaluate(fn: Any, time: np.ndarray, q: np.ndarray, qd: np.ndarray, params: list[float]):
-    """Evaluate an array function along a trajectory; constants broadcast to the time axis."""
-    out = fn(time, *q, *qd, *params)
+    """Evaluate an array function along a trajectory; constants broadcast to the time axis.
+
+    Parameters go in as numpy floats: a product of parameters alone (m·l² with l = 1e155) is not
+    an array, and Python floats raise OverflowError where numpy gives inf. A value too large for
+    a double is inf or nan in the result, for the caller to refuse or flag, never an exception.
+    """
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        out = fn(time, *q, *qd, *(np.float64(p) for p in params))
     return [np.broadcast_to(np.asarray(v, dtype=float), time.shape) for v in out]

@@ -1,34 +1,37 @@
-"""The teaching pages: the catalog, a scene's page, and the spec editor (HTML; data via /api/v1)."""
+"""The teaching pages: the catalog, a scene's page, the spec editor, and the API docs (HTML; data
+via /api/v1). Every page answers ``HEAD`` too (app/middleware.py)."""
 
 from __future__ import annotations
 
-from pathlib import Path
+from typing import Any
 
+import jinja2
 from fastapi import APIRouter, Request
-from fastapi.responses import FileResponse, HTMLResponse
+from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html
+from fastapi.responses import HTMLResponse
 from fastapi.templating import Jinja2Templates
 
 from app.paths import TEMPLATES_DIR, mathjax_dir
 from mechanics.scenes import list_scenes, scene_ids
 
 router = APIRouter(include_in_schema=False)
-templates = Jinja2Templates(directory=str(TEMPLATES_DIR))
 
 
-def _plotly_js() -> Path:
-    import plotly
+def _page_context(request: Request) -> dict[str, Any]:
+    """What every template may use besides its own variables: the CSP nonce of this response
+    (app/middleware.py) for inline scripts."""
+    return {"csp_nonce": getattr(request.state, "csp_nonce", "")}
 
-    return Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+
+@jinja2.pass_context
+def asset(context: jinja2.runtime.Context, path: str) -> str:
+    """``{{ asset("js/scene.js") }}``: the file's versioned URL, cached by the browser for a year
+    (app/assets.py)."""
+    return context["request"].app.state.assets.url(path)
 
 
-@router.get("/static/vendor/plotly.min.js")
-def plotly_js() -> FileResponse:
-    """plotly's own bundle from the installed package: no CDN, cached by the browser."""
-    return FileResponse(
-        _plotly_js(),
-        media_type="text/javascript",
-        headers={"Cache-Control": "public, max-age=86400"},
-    )
+templates = Jinja2Templates(directory=str(TEMPLATES_DIR), context_processors=[_page_context])
+templates.env.globals["asset"] = asset
 
 
 def _page(request: Request, name: str, **context) -> HTMLResponse:
@@ -57,3 +60,39 @@ def scene_page(request: Request, scene_id: str) -> HTMLResponse:
 @router.get("/editor", response_class=HTMLResponse)
 def editor(request: Request) -> HTMLResponse:
     return _page(request, "editor.html", scene_ids=scene_ids())
+
+
+@router.get("/docs", response_class=HTMLResponse)
+def swagger_ui(request: Request) -> HTMLResponse:
+    """Swagger UI from the ``fastapi-offline`` package's files, served by this app: no CDN."""
+    url = request.app.state.assets.url
+    page = get_swagger_ui_html(
+        openapi_url=request.app.openapi_url,
+        title=f"{request.app.title} — API",
+        swagger_js_url=url("api-docs/swagger-ui-bundle.js"),
+        swagger_css_url=url("api-docs/swagger-ui.css"),
+        swagger_favicon_url=url("api-docs/favicon.png"),
+        oauth2_redirect_url=None,
+    )
+    return _with_nonce(page, request)
+
+
+@router.get("/redoc", response_class=HTMLResponse)
+def redoc(request: Request) -> HTMLResponse:
+    """ReDoc from the ``fastapi-offline`` package's files, without Google's fonts."""
+    url = request.app.state.assets.url
+    page = get_redoc_html(
+        openapi_url=request.app.openapi_url,
+        title=f"{request.app.title} — API",
+        redoc_js_url=url("api-docs/redoc.standalone.js"),
+        redoc_favicon_url=url("api-docs/favicon.png"),
+        with_google_fonts=False,
+    )
+    return _with_nonce(page, request)
+
+
+def _with_nonce(page: HTMLResponse, request: Request) -> HTMLResponse:
+    """FastAPI's docs page with this response's CSP nonce on its inline script."""
+    nonce = _page_context(request)["csp_nonce"]
+    body = bytes(page.body).replace(b"<script>", f'<script nonce="{nonce}">'.encode())
+    return HTMLResponse(body)

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 from fastapi import APIRouter, Response
 
 from app.derivations import derive_seconds
+from app.responses import ORJSONResponse
 from app.routes.scenes import unknown_scene
 from app.schemas import Message, MethodOut, SimulateRequest, SimulateResponse, ValidationErrors
 from mechanics.budget import run_with_budget
@@ -46,7 +46,7 @@ def post_simulate(request: SimulateRequest) -> Response:
         result = run_with_budget(
             simulate, scene=document, request=options, seconds=derive_seconds()
         )
-    return Response(content=json.dumps(_finite(result)), media_type="application/json")
+    return ORJSONResponse(result)  # NaN/inf become null, as _finite did
 
 
 @router.get("/methods", response_model=list[MethodOut], summary="List the integration methods")

@@ -106,13 +106,15 @@ class Watched:
     def settle(self, timeout: float = 60_000) -> None:
         """Wait until no API request is in flight (before leaving or reloading the page)."""
         self.page.wait_for_function(
-            "(document.documentElement.dataset.pending || '0') === '0'", timeout=timeout
+            "() => (document.documentElement.dataset.pending || '0') === '0'", timeout=timeout
         )
 
 
 @pytest.fixture(scope="session")
 def context(browser, server):
-    ctx = browser.new_context(viewport={"width": 1300, "height": 900})
+    # Playwright polls a wait_for_function given as an expression string with eval, which the
+    # pages' CSP rightly forbids; the pages under their CSP are tested in tests/test_install.py.
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
     ctx.grant_permissions(["clipboard-read", "clipboard-write"], origin=server)
     yield ctx
     ctx.close()
