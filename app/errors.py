@@ -1,8 +1,10 @@
-"""The one place where errors become HTTP answers, so every 422 has the same shape.
+"""The one place where errors become HTTP answers, so every error has the same shape.
 
 Errors are values with a field path, raised at the edge (the spec, the expression parser, the
-budget) and turned into responses here:
+budget) and turned into responses here, 404, 413, 422 and 503 alike:
 ``{"detail": [{"field": "bodies[0].position[0]", "message": "unknown name 'lenght'"}]}``.
+The field of an unknown scene is ``scene_id``, of a body too large ``body``, of a posted scene past
+its time budget ``scene``; a path that names no route has ``path``.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from typing import Any
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException
 
 from mechanics.budget import BudgetExceeded
 from mechanics.expr import ExprError
@@ -28,12 +31,77 @@ def register_error_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ExprError, expr_error)
     app.add_exception_handler(BudgetExceeded, budget_exceeded)
     app.add_exception_handler(RequestValidationError, request_invalid)
+    app.add_exception_handler(HTTPException, http_error)
+    document_errors(app)
+
+
+def error_body(field: str, message: str) -> dict[str, list[dict[str, str]]]:
+    """The one error shape with one problem, for answers built outside these handlers (the
+    413 of a body past the limit: ``error_body("body", "request body over 1 MiB")``)."""
+    return {"detail": [{"field": field, "message": message}]}
 
 
 def unprocessable(errors: Iterable[dict[str, str]]) -> JSONResponse:
     """A 422 listing every problem as {field, message}."""
     detail = [{"field": e["field"], "message": _readable(e["message"])} for e in errors]
     return JSONResponse({"detail": detail}, status_code=422)
+
+
+async def http_error(request: Request, exc: HTTPException) -> JSONResponse:
+    """An HTTPException (an unknown scene's 404, a route's 405) in the one shape. A detail
+    that is already a list of {field, message} is kept; a sentence gets the field it is about:
+    ``scene_id`` for a 404 of a matched route (the only 404 a route raises), ``path`` for a
+    404/405 of the URL itself, ``scene`` for a 503, else ``body``."""
+    if isinstance(exc.detail, list):
+        body: dict[str, Any] = {"detail": exc.detail}
+    else:
+        matched = request.scope.get("route") is not None
+        if exc.status_code == 404 and matched:
+            field = "scene_id"
+        elif exc.status_code in (404, 405):
+            field = "path"
+        elif exc.status_code == 503:
+            field = "scene"  # the only work refused for load is a posted scene's
+        else:
+            field = "body"
+        body = error_body(field, str(exc.detail))
+    return JSONResponse(body, status_code=exc.status_code, headers=exc.headers)
+
+
+#: What every /api/v1 operation may answer besides its own, documented on each in OpenAPI.
+_SHARED_ERRORS = {
+    413: "The request body is over the size limit (field `body`).",
+    422: "A field is invalid; every problem is listed with its field.",
+}
+
+
+def document_errors(app: FastAPI) -> None:
+    """Add the shared error answers (413 and 422 of any POST) to every API operation in the
+    OpenAPI document, in the one error shape, where the route did not document them."""
+    generate = app.openapi
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema:
+            return app.openapi_schema
+        schema = generate()
+        components = schema.setdefault("components", {}).setdefault("schemas", {})
+        if "ValidationErrors" not in components:
+            from app.schemas import ValidationErrors
+
+            shape = ValidationErrors.model_json_schema(ref_template="#/components/schemas/{model}")
+            components.update(shape.pop("$defs", {}))
+            components["ValidationErrors"] = shape
+        ref = {"$ref": "#/components/schemas/ValidationErrors"}
+        for path, operations in schema.get("paths", {}).items():
+            post = operations.get("post") if path.startswith("/api/") else None
+            for status, description in _SHARED_ERRORS.items() if post else ():
+                post.setdefault("responses", {}).setdefault(
+                    str(status),
+                    {"description": description, "content": {"application/json": {"schema": ref}}},
+                )
+        return schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
 
 
 async def spec_error(request: Request, exc: SpecError) -> JSONResponse:
@@ -48,7 +116,7 @@ async def budget_exceeded(request: Request, exc: BudgetExceeded) -> JSONResponse
     """Time is the server's limit (503: try later, or simplify); size is the scene's (422)."""
     message = f"{exc.kind} budget exceeded: {exc.message}"
     if exc.kind == "time":
-        return JSONResponse({"detail": message}, status_code=503)
+        return JSONResponse(error_body("scene", message), status_code=503)
     return unprocessable([{"field": "scene", "message": message}])
 
 

@@ -7,14 +7,20 @@ JSON stays stable until a field is added here on purpose.
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StringConstraints, model_validator
 from pydantic_core import PydanticCustomError
 
+from mechanics.check import QUANTITIES
+from mechanics.integrators import METHODS
 from mechanics.spec import SceneSpec
 
 SceneId = Annotated[str, StringConstraints(pattern=r"^[a-z0-9_]{1,64}$")]
+#: The registry's names and the checkable quantities, as enums in the OpenAPI document; an unknown
+#: value is a 422 naming the field, like every other bad value.
+MethodName = Literal[tuple(METHODS)]  # type: ignore[valid-type]
+Quantity = Literal[QUANTITIES]  # type: ignore[valid-type]
 
 
 class ErrorDetail(BaseModel):
@@ -29,15 +35,15 @@ class ErrorDetail(BaseModel):
 
 
 class ValidationErrors(BaseModel):
-    """The body of every 422: all problems found, not only the first."""
+    """The body of every error the API answers (404, 413, 422, 503): all problems found, not
+    only the first, each with the field it is about (`scene_id` for an unknown scene, `body` for
+    a body too large, `scene` for a posted scene past its budget)."""
 
     detail: list[ErrorDetail]
 
 
-class Message(BaseModel):
-    """The body of a 404 or 503: one sentence for a person."""
-
-    detail: str
+#: The same shape under the name the 404 and 503 responses were documented with.
+Message = ValidationErrors
 
 
 class Health(BaseModel):
@@ -166,8 +172,12 @@ class SimulateRequest(DeriveRequest):
         default={}, description="Initial q and q_dot (`theta`, `theta_dot`); default the scene's."
     )
     t_end: float = Field(default=10.0, description="Seconds of motion (≤ 1000).")
-    fps: float = Field(default=60.0, description="Output samples per second (≤ 240).")
-    method: str = Field(
+    fps: float = Field(
+        default=60.0,
+        description="Output samples per second (> 0), as many as t_end × fps + 1 ≤ 20001 "
+        "samples allow: 100 samples over 1 ms is fps = 1e5.",
+    )
+    method: MethodName = Field(  # type: ignore[valid-type]
         default="DOP853",
         description="euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
         "RK45, DOP853, dop853_c, dop853_fortran, Radau, BDF, LSODA (adaptive: rtol, atol); "
@@ -297,7 +307,9 @@ class CheckRequest(DeriveRequest):
         },
     )
 
-    quantity: str = Field(description="T, V, L, Q, eom, accel or momentum.")
+    quantity: Quantity = Field(  # type: ignore[valid-type]
+        description="T, V, L, Q, eom, accel or momentum."
+    )
     coordinate: str | None = Field(
         default=None, description="The coordinate, for Q, eom, accel and momentum."
     )

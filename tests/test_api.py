@@ -77,7 +77,9 @@ def test_one_scene_is_its_spec(client):
 def test_an_unknown_scene_is_404(client, scene_id):
     response = client.get(f"/api/v1/scenes/{scene_id}")
     assert response.status_code == 404
-    assert response.json() == {"detail": f"unknown scene '{scene_id}'"}
+    assert response.json() == {
+        "detail": [{"field": "scene_id", "message": f"unknown scene '{scene_id}'"}]
+    }
 
 
 def test_a_path_for_a_scene_id_is_404(client):
@@ -87,7 +89,9 @@ def test_a_path_for_a_scene_id_is_404(client):
 def test_deriving_an_unknown_scene_is_404(client):
     response = client.post("/api/v1/derive", json={"scene_id": "no_such_scene"})
     assert response.status_code == 404
-    assert response.json() == {"detail": "unknown scene 'no_such_scene'"}
+    assert response.json() == {
+        "detail": [{"field": "scene_id", "message": "unknown scene 'no_such_scene'"}]
+    }
 
 
 # --- derive: built-in and posted scenes -----------------------------------------------------
@@ -114,7 +118,8 @@ def test_a_posted_scene_past_its_time_budget_is_503(client, monkeypatch):
     monkeypatch.setenv("LAGRANGE_LAB_DERIVE_SECONDS", "0.001")
     response = client.post("/api/v1/derive", json={"scene": PENDULUM})
     assert response.status_code == 503
-    assert "time budget" in response.json()["detail"]
+    (problem,) = response.json()["detail"]
+    assert problem["field"] == "scene" and "time budget" in problem["message"]
 
 
 # --- derive: the request and the spec are checked, errors name their field ------------------
