@@ -1,14 +1,14 @@
 """Runs the derivation steps in order; caching lives here, nowhere else.
 
-Two caches, because the two users differ: the JSON of a built-in scene's derivation is kept in
-memory and on disk (a restarted server, or another worker, answers at once), while the sympy
-objects a simulation compiles from are kept in memory per process.
+Two caches, because the two users differ: the JSON of a derivation goes through the ``derivation``
+store of mechanics/cache.py (memory, then the disk or Redis: a restarted server, another worker or
+another machine answers at once), keyed by the canonical spec (`derivation_key`); the sympy objects
+a simulation compiles from are kept in memory per process.
 """
 
 from __future__ import annotations
 
 import functools
-import json
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -29,8 +29,8 @@ from mechanics.steps.kinematics import kinematics
 from mechanics.steps.lagrange import lagrange_equations
 from mechanics.steps.matrix_form import mass_matrix_form
 
-#: Bump when the derivation's output changes, so stale on-disk entries are never served.
-ENGINE_VERSION = "2"
+#: Bump (in mechanics/cache.py) when the derivation's output changes: it is part of every key.
+ENGINE_VERSION = cache.ENGINE_VERSION
 
 STEPS = (
     free_body_diagram,
@@ -130,21 +130,40 @@ def derivation_of_scene(scene_id: str, branches: tuple[tuple[int, int], ...] = (
     return derive_model(parse_spec(load_scene(scene_id)), dict(branches) or None)
 
 
-_memory: dict[str, dict[str, Any]] = {}
+def derivation_key(spec: SceneSpec | dict) -> dict[str, Any]:
+    """What defines a derivation: the spec, validated and written canonically (defaults left out),
+    so a posted copy of a built-in scene, or the same spec with its keys in another order or its
+    defaults spelled out, is the same cache entry. Raises SpecError for a spec that does not
+    parse."""
+    spec = spec if isinstance(spec, SceneSpec) else parse_spec(spec)
+    return {"spec": spec.model_dump(mode="json", by_alias=True, exclude_defaults=True)}
+
+
+def derive_cached(spec: SceneSpec | dict, compute: Any = None) -> dict[str, Any]:
+    """The JSON derivation of any spec through the ``derivation`` store: found, or computed once
+    by ``compute()`` (default: `derive` here; the web layer passes its pool job) and shared."""
+    return cache.get_or_compute(
+        "derivation",
+        derivation_key(spec),
+        compute or (lambda: derive(spec)),
+        validate=is_derivation_json,
+    )
+
+
+@functools.lru_cache(maxsize=128)
+def _scene_key(scene_id: str) -> dict[str, Any]:
+    return derivation_key(load_scene(scene_id))  # KeyError for an unknown scene
 
 
 def derive_scene(scene_id: str) -> dict[str, Any]:
-    """A built-in scene's derivation, from memory, then disk, then computed (and stored)."""
-    if scene_id in _memory:
-        return _memory[scene_id]
-    raw = load_scene(scene_id)  # KeyError for an unknown scene, before any work
-    key = cache.key_for({"scene": raw}, ENGINE_VERSION)
-    result = cache.get(key, version=ENGINE_VERSION, valid=is_derivation_json)
-    if result is None:
-        result = derivation_of_scene(scene_id).to_json()
-        cache.put(key, json.loads(json.dumps(result)), version=ENGINE_VERSION)
-    _memory[scene_id] = result
-    return result
+    """A built-in scene's derivation, from the cache (memory, disk or Redis), else computed once
+    and stored: the same entry as a posted copy of the scene."""
+    return cache.get_or_compute(
+        "derivation",
+        _scene_key(scene_id),
+        lambda: derivation_of_scene(scene_id).to_json(),
+        validate=is_derivation_json,
+    )
 
 
 def is_derivation_json(value: Any) -> bool:

@@ -9,8 +9,10 @@ identifiers before it is compiled.
 
 Compiling needs a C compiler (`cc`, or ``$LAGRANGE_LAB_CC``; set it to ``none`` to switch this
 off). Each shared library is cached on disk under a hash of its source, so a scene compiles once
-per machine. Without a compiler everything still works: `available()` says why not, and callers
-fall back to scipy's DOP853, which takes the same steps.
+per machine, and loaded only after its bytes and its source match the sha256 recorded beside it
+when it was built (a truncated or swapped file is rebuilt, never run). Without a compiler
+everything still works: `available()` says why not, and callers fall back to scipy's DOP853,
+which takes the same steps.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
+import json
 import logging
 import os
 import platform
@@ -91,7 +94,12 @@ _refused: dict[tuple[str, str], NativeUnavailable] = {}
 
 def _build(source: str, kind: str) -> ctypes.CDLL:
     """Compile `source` to a shared library (once per machine: cached by the hash of source,
-    flags and platform) and load it. Raises NativeUnavailable with the reason."""
+    flags and platform) and load it. Raises NativeUnavailable with the reason.
+
+    A cached library is loaded only when its sidecar (``<name>.json``) records the sha256 of the
+    library's bytes and of the source it was built from and both match: a truncated, damaged or
+    swapped file is rebuilt, never run. Libraries are never taken from another machine; only the
+    source may be shared (the ``native-source`` store of mechanics/cache.py)."""
     cc = compiler()
     if cc is None:
         raise NativeUnavailable("no C compiler found (install gcc, or set LAGRANGE_LAB_CC)")
@@ -105,31 +113,90 @@ def _build(source: str, kind: str) -> ctypes.CDLL:
     with lock:
         if (cc, str(target)) in _refused:
             raise _refused[cc, str(target)]
-        if not target.exists():
-            try:
-                folder.mkdir(parents=True, exist_ok=True)
-                with tempfile.TemporaryDirectory(dir=folder) as tmp:
-                    c_file, so_file = Path(tmp) / "src.c", Path(tmp) / "out.so"
-                    c_file.write_text(source)
-                    done = subprocess.run(
-                        [cc, *FLAGS, "-o", str(so_file), str(c_file), "-lm"],
-                        capture_output=True,
-                        text=True,
-                        timeout=COMPILE_TIMEOUT,
-                    )
-                    if done.returncode != 0:
-                        log.warning("C compile failed: %s", done.stderr[-2000:])
-                        failure = NativeUnavailable(f"the C compiler failed: {done.stderr[-300:]}")
-                        _refused[cc, str(target)] = failure
-                        raise failure
-                    os.replace(so_file, target)  # atomic: other processes see all or nothing
-                _prune(folder)
-            except (OSError, subprocess.SubprocessError) as exc:
-                raise NativeUnavailable(f"could not compile C code: {exc}") from exc
+        library = _verified_library(target, source)
+        if library is None:
+            library = _compile(cc, source, target)
+            _prune(folder)
+        return _load(library, folder)
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _verified_library(target: Path, source: str) -> bytes | None:
+    """The cached library's bytes if its sidecar vouches for them and for `source`, else None."""
+    try:
+        record = json.loads(target.with_suffix(".json").read_text())
+        data = target.read_bytes()
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError) as exc:
+        log.warning("native: cannot read the cached %s (%s); rebuilding", target.name, exc)
+        return None
+    if not (
+        isinstance(record, dict)
+        and record.get("source_sha256") == _sha256(source.encode())
+        and record.get("library_sha256") == _sha256(data)
+    ):
+        log.warning("native: %s does not match its record; rebuilding", target.name)
+        return None
+    return data
+
+
+def _compile(cc: str, source: str, target: Path) -> bytes:
+    """Compile `source` into `target` and its sidecar (each written atomically); its bytes."""
+    folder = target.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=folder) as tmp:
+            c_file, so_file = Path(tmp) / "src.c", Path(tmp) / "out.so"
+            c_file.write_text(source)
+            done = subprocess.run(
+                [cc, *FLAGS, "-o", str(so_file), str(c_file), "-lm"],
+                capture_output=True,
+                text=True,
+                timeout=COMPILE_TIMEOUT,
+            )
+            if done.returncode != 0:
+                log.warning("C compile failed: %s", done.stderr[-2000:])
+                failure = NativeUnavailable(f"the C compiler failed: {done.stderr[-300:]}")
+                _refused[cc, str(target)] = failure
+                raise failure
+            data = so_file.read_bytes()
+            record = Path(tmp) / "record.json"
+            record.write_text(
+                json.dumps(
+                    {
+                        "library_sha256": _sha256(data),
+                        "source_sha256": _sha256(source.encode()),
+                        "compiler": cc,
+                        "flags": list(FLAGS),
+                    }
+                )
+            )
+            # Library first, then its record: a reader between the two sees a mismatch and
+            # rebuilds; atomic replaces mean no reader sees half a file.
+            os.replace(so_file, target)
+            os.replace(record, target.with_suffix(".json"))
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise NativeUnavailable(f"could not compile C code: {exc}") from exc
+    return data
+
+
+def _load(library: bytes, folder: Path) -> ctypes.CDLL:
+    """Load exactly the verified bytes: a private copy, so the file cannot change between the
+    check and dlopen (and dlopen never hands back another library loaded under the same name)."""
+    try:
+        fd, path = tempfile.mkstemp(dir=folder, prefix=".load-", suffix=".so")
         try:
-            return ctypes.CDLL(str(target))
-        except OSError as exc:
-            raise NativeUnavailable(f"could not load the compiled library: {exc}") from exc
+            with os.fdopen(fd, "wb") as f:
+                f.write(library)
+            return ctypes.CDLL(path)
+        finally:
+            os.unlink(path)  # the mapping stays; nothing is left on disk
+    except OSError as exc:
+        raise NativeUnavailable(f"could not load the compiled library: {exc}") from exc
 
 
 #: Each posted scene leaves a library (~16 kB) behind; past this many the oldest go.
@@ -141,6 +208,7 @@ def _prune(folder: Path) -> None:
     libraries = sorted(folder.glob("rhs-*.so"), key=lambda f: f.stat().st_mtime)
     for old in libraries[: max(0, len(libraries) - MAX_LIBRARIES)]:
         old.unlink(missing_ok=True)
+        old.with_suffix(".json").unlink(missing_ok=True)
 
 
 def _c_array(name: str, values: np.ndarray) -> str:
