@@ -14,6 +14,7 @@ import secrets
 from starlette.datastructures import Headers, MutableHeaders
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from app.errors import error_body
 from app.responses import ORJSONResponse
 
 #: Everything the pages load comes from the app itself. Styles may be inline: MathJax's SVG
@@ -81,8 +82,7 @@ class HeadAsGet:
 
 
 class BodyLimit:
-    """Refuses a request body over ``max_bytes`` with 413 ``{"detail": ...}`` (app/errors.py's
-    shape for errors that are not about a field).
+    """Refuses a request body over ``max_bytes`` with 413 in the one error shape (field `body`).
 
     A declared Content-Length over the limit is refused before the app runs. A chunked body is
     counted as the app reads it; past the limit the app is told the client left and whatever it
@@ -137,7 +137,8 @@ class BodyLimit:
             await self._refuse(scope, receive, send)
 
     async def _refuse(self, scope: Scope, receive: Receive, send: Send) -> None:
-        await ORJSONResponse({"detail": self.detail}, status_code=413)(scope, receive, send)
+        body = error_body("body", self.detail)
+        await ORJSONResponse(body, status_code=413)(scope, receive, send)
 
 
 def _size(n: int) -> str:

@@ -233,7 +233,7 @@ def test_a_declared_body_over_the_limit_is_refused_unread(client):
         headers={"content-type": "application/json", "content-length": str(2 * 1024 * 1024)},
     )
     assert r.status_code == 413
-    assert r.json() == {"detail": "request body over 1 MiB"}
+    assert r.json() == {"detail": [{"field": "body", "message": "request body over 1 MiB"}]}
 
 
 # -- a real server ---------------------------------------------------------------------------
@@ -314,7 +314,7 @@ def test_a_chunked_body_over_the_limit_is_refused_as_it_streams(served):
     before = _rss_mib(pid)
     answer, sent = _post_chunked(port, mib=200)
     assert answer.startswith(b"HTTP/1.1 413")
-    assert answer.endswith(b'{"detail":"request body over 1 MiB"}')
+    assert answer.endswith(b'{"detail":[{"field":"body","message":"request body over 1 MiB"}]}')
     assert sent < 40 * 1024 * 1024  # refused long before the 200 MiB were sent
     assert _rss_mib(pid) - before < 50  # never held in memory
 
