@@ -443,3 +443,38 @@ def test_a_library_without_its_record_is_rebuilt(libraries, monkeypatch):
     files[1].with_suffix(".json").unlink()
     runs = builds(monkeypatch)
     assert accelerations(sources) == [-1.0, -5.0] and len(runs) == 1
+
+
+# --- C source from the shared cache: checked before it is compiled -----------------------------
+
+
+def test_every_generated_source_passes_the_check_of_a_shared_source():
+    from mechanics.numeric import compiled_scene
+    from mechanics.scenes import scene_ids
+
+    for scene_id in scene_ids():
+        assert native.is_generated_source(compiled_scene(scene_id).native_source), scene_id
+    args = list(sp.symbols("t_ q_0 q_1 u_0 u_1 k"))
+    q0, q1, k = args[1], args[2], args[5]
+    mass = [2 + sp.cos(q1), 1, 1, 3]  # M q̈ = f, solved in C: the source carries lab_solve
+    source = native.rhs_source(args, 2, sp.S.Zero, mass=mass, forcing=[-k * q0, -k * q1])
+    assert "lab_solve" in source and native.is_generated_source(source)
+
+
+@pytest.mark.parametrize(
+    ("find", "replace"),
+    [
+        ("    return 0;\n}", '    return 0;\n}\nint evil(void) { return system("x"); }'),
+        ("#include <math.h>", "#include <stdlib.h>"),
+        ("    dy[0] = y[1];", '    dy[0] = y[1]; system("rm -rf /");'),
+        ("    dy[0] = y[1];", "    dy[0] = system(0);"),
+        ("    dy[0] = y[1];", "    dy[0] = y[1] /* hidden */;"),
+        ("    dy[0] = y[1];", "#define sin system\n    dy[0] = y[1];"),
+        ("/* lab: dim 3 params 0 */", "/* lab: dim 3 params 9 */ int x;"),
+    ],
+)
+def test_a_source_that_is_not_generated_is_refused(find, replace):
+    args = list(sp.symbols("t_ q_0 u_0"))
+    source = native.rhs_source(args, 1, sp.S.Zero, accelerations=[-sp.sin(args[1])])
+    assert native.is_generated_source(source) and find in source
+    assert not native.is_generated_source(source.replace(find, replace, 1))

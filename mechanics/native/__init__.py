@@ -417,6 +417,41 @@ def _assemble(
     )
 
 
+_GENERATED_LINE = re.compile(
+    r"    (?:const double x\d+|dy\[\d+\]|a\[\d+\]|b\[\d+\]) = ([^;{}#\"'/\\]|/(?![/*]))+;"
+    r"|    double a\[\d+\], b\[\d+\];"
+    rf"|    if \(lab_solve\(\d+, a, b\)\) return {RHS_SINGULAR};"
+)
+_RHS_HEAD = [
+    "#include <math.h>",
+    "int lab_rhs(double t, const double *y, const double *p, double *dy) {",
+    "    (void)t; (void)p;",
+]
+
+
+def is_generated_source(source: object) -> bool:
+    """Is ``source`` what `rhs_source` prints, line by line? The check a right-hand side's C
+    passes before it is compiled when it comes from the shared cache (the ``native-source``
+    store): assignments of whitelisted expressions to numbered slots, the fixed solver, nothing
+    else (no other function, directive, comment or call outside libm)."""
+    if not isinstance(source, str):
+        return False
+    first, _, rest = source.replace(_SOLVE, "\n", 1).partition("\n")
+    lines = [line for line in rest.split("\n") if line]
+    if _SHAPE.fullmatch(first) is None:
+        return False
+    if lines[:3] != _RHS_HEAD or lines[-2:] != ["    return 0;", "}"]:
+        return False
+    body = lines[3:-2]
+    if not all(_GENERATED_LINE.fullmatch(line) for line in body):
+        return False
+    try:
+        _checked("\n".join(line.split(" = ", 1)[-1] for line in body if " = " in line))
+    except NativeUnavailable:
+        return False
+    return True
+
+
 @functools.lru_cache(maxsize=128)
 def _rhs_library(source: str) -> ctypes.CDLL:
     return _build(source, "rhs")
