@@ -151,8 +151,10 @@ def derive_cached(spec: SceneSpec | dict, compute: Any = None) -> dict[str, Any]
 
 
 @functools.lru_cache(maxsize=128)
-def _scene_key(scene_id: str) -> dict[str, Any]:
-    return derivation_key(load_scene(scene_id))  # KeyError for an unknown scene
+def scene_key(scene_id: str) -> dict[str, Any]:
+    """`derivation_key` of a built-in scene, once per process (KeyError for an unknown one); the
+    start of the key of any per-scene result (equilibria, newton, check). Do not change it."""
+    return derivation_key(load_scene(scene_id))
 
 
 def derive_scene(scene_id: str) -> dict[str, Any]:
@@ -160,7 +162,7 @@ def derive_scene(scene_id: str) -> dict[str, Any]:
     and stored: the same entry as a posted copy of the scene."""
     return cache.get_or_compute(
         "derivation",
-        _scene_key(scene_id),
+        scene_key(scene_id),
         lambda: derivation_of_scene(scene_id).to_json(),
         validate=is_derivation_json,
     )

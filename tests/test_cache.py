@@ -214,7 +214,7 @@ def test_a_tampered_derivation_is_recomputed_and_a_posted_copy_shares_the_entry(
 def test_a_derivation_entry_of_the_wrong_shape_is_recomputed(value):
     """An entry whose header and hash are right (written by a buggy engine of this version) but
     whose value is not a derivation: is_derivation_json refuses it, the scene is derived again."""
-    parts = derive._scene_key("simple_pendulum")
+    parts = derive.scene_key("simple_pendulum")
     cache.get_or_compute("derivation", parts, lambda: value)  # stored: no validator given
     forget_memory()
     answer = derive.derive_scene("simple_pendulum")
