@@ -29,10 +29,8 @@ from sympy.physics.mechanics import (
     msubs,
 )
 
-from mechanics import cache, derive
 from mechanics.bench import SYSTEMS
-from mechanics.derive import ENGINE_VERSION, derive_model, derive_scene, is_derivation_json
-from mechanics.scenes import load_scene
+from mechanics.derive import derive_model
 
 TRIPLE_PENDULUM = SYSTEMS["triple_pendulum"]
 HEAVY_TOP = SYSTEMS["heavy_top"]
@@ -196,71 +194,3 @@ def test_solved_accelerations_of_the_top_agree_with_m_inverse_f() -> None:
     expected = M.LUsolve(f)
     for ours, theirs in zip(d.work.accelerations, expected, strict=True):
         assert float(msubs(ours, subs)) == pytest.approx(float(theirs), rel=1e-9, abs=1e-12)
-
-
-# --- the disk cache serves this engine's entries of the right shape, nothing else ----------------
-
-
-@pytest.fixture
-def empty_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
-    monkeypatch.setenv("LAGRANGE_LAB_CACHE", str(tmp_path))
-    monkeypatch.setattr(derive, "_memory", {})
-    return cache.key_for({"scene": load_scene("simple_pendulum")}, ENGINE_VERSION)
-
-
-def write_entry(key: str, entry: object) -> None:
-    (cache.cache_dir() / f"{key}.json").write_text(json.dumps(entry), encoding="utf-8")
-
-
-def served(key: str) -> dict:
-    """What derive_scene answers, checked to be a real derivation, and what it left on disk."""
-    answer = derive_scene("simple_pendulum")
-    assert is_derivation_json(answer)
-    assert answer["equations"]["accelerations"] is not None
-    assert cache.get(key, version=ENGINE_VERSION, valid=is_derivation_json) == answer
-    return answer
-
-
-def bogus_derivation() -> dict:
-    value = json.loads(json.dumps(derive_scene("simple_pendulum")))
-    derive._memory.clear()
-    value["equations"]["accelerations"] = None  # what a slow run of the old engine left behind
-    return value
-
-
-def test_an_entry_of_another_engine_version_is_recomputed(empty_cache: str) -> None:
-    stale = bogus_derivation()
-    write_entry(empty_cache, {"engine": "0", "key": empty_cache, "value": stale})
-    assert served(empty_cache) != stale
-
-
-def test_an_entry_from_before_versioned_entries_is_recomputed(empty_cache: str) -> None:
-    stale = bogus_derivation()
-    write_entry(empty_cache, stale)  # the bare value, as the old cache stored it
-    assert served(empty_cache) != stale
-
-
-@pytest.mark.parametrize(
-    "value",
-    [
-        {"answer": 42},
-        {"scene": {}, "steps": [], "equations": {}, "latex": {}, "warnings": [], "seconds": 0},
-        [1, 2, 3],
-        "not an object",
-        None,
-    ],
-)
-def test_an_entry_of_the_wrong_shape_is_recomputed(empty_cache: str, value: object) -> None:
-    write_entry(empty_cache, {"engine": ENGINE_VERSION, "key": empty_cache, "value": value})
-    assert served(empty_cache) != value
-
-
-def test_a_truncated_entry_is_recomputed(empty_cache: str) -> None:
-    (cache.cache_dir() / f"{empty_cache}.json").write_text('{"engine": "', encoding="utf-8")
-    served(empty_cache)
-
-
-def test_an_entry_filed_under_another_key_is_recomputed(empty_cache: str) -> None:
-    stale = bogus_derivation()
-    write_entry(empty_cache, {"engine": ENGINE_VERSION, "key": "0" * 64, "value": stale})
-    assert served(empty_cache) != stale
