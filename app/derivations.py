@@ -1,26 +1,35 @@
-"""The web layer's two ways into the engine's derivation, as ready-to-send JSON bytes.
+"""The web layer's ways into the engine: built-in derivations from memory, the rest in the pool.
 
-A built-in scene is trusted and the same for everyone: its response is serialised once per process
-and then served from a dict, so a warm request costs a lookup (the engine's own cache would still
-make FastAPI re-validate and re-encode a large response every time). A posted scene is untrusted
-work: it runs in a child process under a wall-time and memory budget.
+A built-in scene is trusted and the same for everyone: its derivation is serialised once per process
+and then served from a dict, so a warm request costs a lookup. Everything that runs sympy on user
+input (a posted spec, a student's answer, equilibria and Newton's method of any scene) is a job for
+the pool of warm worker processes (mechanics/pool.py): under a wall-time and memory budget, with
+fair admission per client, in a process that can be killed without harming the server.
 
-``mechanics.derive`` is imported on first use, in the serving process (so forked children inherit
-it): the app starts, answers /healthz, lists scenes and refuses bad specs without the derivation
-steps loaded.
+The pool is started with the app (`start_pool`, from its lifespan, before the threadpool serves
+anything) and closed with it; a request that finds no pool (a test client without lifespan) starts
+one. Its size and per-client limit come from the environment:
+
+- ``LAGRANGE_LAB_DERIVE_SECONDS``: the wall-time budget of one job, queueing included (20 s);
+- ``LAGRANGE_LAB_POOL_WORKERS``: worker processes per server process (the number of cores, ≥ 2);
+- ``LAGRANGE_LAB_POOL_PER_CLIENT``: jobs one client may have running at once (half the workers);
+- ``LAGRANGE_LAB_TRUST_FORWARDED``: ``1`` when behind a proxy that sets X-Forwarded-For (the
+  client is then its last address, the one the proxy saw); otherwise the peer address is.
 """
 
 from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Callable
+import threading
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
 from typing import Any
 
-from fastapi import HTTPException
+from fastapi import HTTPException, Request
 
 from app.schemas import DeriveResponse
-from mechanics.budget import run_with_budget
+from mechanics.pool import WorkerLost, WorkerPool
 from mechanics.scenes import scene_ids
 from mechanics.spec import SceneSpec, parse_spec
 
@@ -28,12 +37,21 @@ log = logging.getLogger(__name__)
 
 DERIVE_SECONDS_ENV = "LAGRANGE_LAB_DERIVE_SECONDS"
 DEFAULT_DERIVE_SECONDS = 20.0
+POOL_WORKERS_ENV = "LAGRANGE_LAB_POOL_WORKERS"
+POOL_PER_CLIENT_ENV = "LAGRANGE_LAB_POOL_PER_CLIENT"
+TRUST_FORWARDED_ENV = "LAGRANGE_LAB_TRUST_FORWARDED"
+
+SIMPLIFY_SCENE = (
+    "simplify the scene (fewer coordinates or bodies, simpler expressions) and try again"
+)
 
 _ready: dict[str, bytes] = {}
+_pool: WorkerPool | None = None
+_pool_lock = threading.Lock()
 
 
 def derive_seconds() -> float:
-    """The wall-time budget of one posted derivation: ``$LAGRANGE_LAB_DERIVE_SECONDS`` or 20 s."""
+    """The wall-time budget of one job: ``$LAGRANGE_LAB_DERIVE_SECONDS`` or 20 s."""
     raw = os.environ.get(DERIVE_SECONDS_ENV)
     if raw is None:
         return DEFAULT_DERIVE_SECONDS
@@ -45,6 +63,96 @@ def derive_seconds() -> float:
         log.warning("%s=%r is not a positive number of seconds; using 20", DERIVE_SECONDS_ENV, raw)
         return DEFAULT_DERIVE_SECONDS
     return seconds
+
+
+def _positive_int(name: str, default: int) -> int:
+    raw = os.environ.get(name, "")
+    if raw.strip().isdigit() and int(raw) > 0:
+        return int(raw)
+    if raw:
+        log.warning("%s=%r is not a positive integer; using %d", name, raw, default)
+    return default
+
+
+def start_pool() -> WorkerPool:
+    """The running pool, started (workers warm) if there is none."""
+    global _pool
+    with _pool_lock:
+        if _pool is None:
+            size = _positive_int(POOL_WORKERS_ENV, max(2, os.cpu_count() or 1))
+            per_client = _positive_int(POOL_PER_CLIENT_ENV, max(1, size // 2))
+            _pool = WorkerPool(size=size, per_client=per_client).start()
+        return _pool
+
+
+def stop_pool() -> None:
+    """Close the pool: its workers exit and are reaped."""
+    global _pool
+    with _pool_lock:
+        pool, _pool = _pool, None
+    if pool is not None:
+        pool.close()
+
+
+@asynccontextmanager
+async def pool_lifespan(app: Any) -> AsyncIterator[None]:
+    """The app's lifespan: the pool starts (its workers warm) before the first request and is
+    closed, its workers reaped, when the server stops."""
+    start_pool()
+    try:
+        yield
+    finally:
+        stop_pool()
+
+
+def client_of(http: Request) -> str:
+    """Who is asking, for the per-client limit: the peer address, or the address the trusted
+    proxy saw (the last in X-Forwarded-For) when ``LAGRANGE_LAB_TRUST_FORWARDED=1``."""
+    if os.environ.get(TRUST_FORWARDED_ENV) == "1":
+        forwarded = http.headers.get("x-forwarded-for", "").split(",")[-1].strip()
+        if forwarded:
+            return forwarded
+    return http.client.host if http.client is not None else ""
+
+
+def in_pool(
+    http: Request,
+    job: Any,
+    *args: Any,
+    affinity: str | None,
+    what: str,
+    advice: str = SIMPLIFY_SCENE,
+) -> Any:
+    """``job(*args)`` in a pool worker under the budget; a lost worker is a 503, not a 500.
+
+    ``what`` and ``advice`` make the message past the budget: "{what} took longer than 20 s;
+    {advice}".
+    """
+    pool = _pool or start_pool()
+    try:
+        return pool.run(
+            job,
+            *args,
+            seconds=derive_seconds(),
+            client=client_of(http),
+            affinity=affinity,
+            what=what,
+            advice=advice,
+        )
+    except WorkerLost as lost:  # in the one error shape (app/errors.py), like a time budget's
+        detail = [{"field": "scene", "message": f"{lost}; try again"}]
+        raise HTTPException(status_code=503, detail=detail) from None
+
+
+def posted_key(scene: SceneSpec) -> str:
+    """A posted scene's key for the pool (see mechanics.jobs.spec_key), after the cross-field
+    checks (names declared once, references that resolve): cheap, and a spec that fails them need
+    not cost a worker."""
+    from mechanics.jobs import spec_key
+
+    document = scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    parse_spec(document)
+    return spec_key(document)
 
 
 def scene_json(scene_id: str) -> bytes | None:
@@ -59,17 +167,12 @@ def scene_json(scene_id: str) -> bytes | None:
     return body
 
 
-def posted_json(scene: SceneSpec) -> bytes:
-    """The derivation of a posted scene as JSON bytes, computed under the time budget.
+def posted_json(http: Request, scene: SceneSpec) -> bytes:
+    """The derivation of a posted scene as JSON bytes, computed in the pool."""
+    from mechanics.jobs import derivation_json
 
-    The cross-field checks (names declared once, references that resolve) run here first: they are
-    cheap, and a spec that fails them need not cost a process.
-    """
-    document = scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
-    parse_spec(document)
-    from mechanics.derive import derive
-
-    return _encode(run_with_budget(derive, document, seconds=derive_seconds()))
+    key = posted_key(scene)
+    return _encode(in_pool(http, derivation_json, key, affinity=key, what="deriving this scene"))
 
 
 def _encode(result: dict[str, Any]) -> bytes:
@@ -77,22 +180,16 @@ def _encode(result: dict[str, Any]) -> bytes:
     return DeriveResponse.model_validate(result).model_dump_json().encode()
 
 
-def on_scene(request: Any, work: Callable[..., Any], *args: Any) -> Any:
-    """``work(derivation, *args)`` for the scene a request names, the one way every analysis route
-    reaches the engine: a built-in scene in this process (its derivation is cached), a posted one
-    in a child process under the time and memory budget."""
+def on_scene(
+    http: Request, request: Any, job: Any, *args: Any, what: str, advice: str = SIMPLIFY_SCENE
+) -> Any:
+    """``job(scene_id, key, *args)`` in the pool for the scene a request names (a built-in one by
+    id, a posted one by its key), the one way the analysis routes reach the engine."""
     if request.scene_id is not None:
         if request.scene_id not in scene_ids():
             raise HTTPException(status_code=404, detail=f"unknown scene '{request.scene_id}'")
-        from mechanics.derive import derivation_of_scene
-
-        return work(derivation_of_scene(request.scene_id), *args)
-    document = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
-    parse_spec(document)
-    return run_with_budget(_derive_then, document, work, *args, seconds=derive_seconds())
-
-
-def _derive_then(document: dict, work: Callable[..., Any], *args: Any) -> Any:
-    from mechanics.derive import derive_model
-
-    return work(derive_model(document), *args)
+        scene_id, key = request.scene_id, None
+    else:
+        scene_id, key = None, posted_key(request.scene)
+    affinity = scene_id or key
+    return in_pool(http, job, scene_id, key, *args, affinity=affinity, what=what, advice=advice)

@@ -12,6 +12,7 @@ from starlette.types import ASGIApp
 
 from app import __version__
 from app.assets import Assets, content_version, package_version
+from app.derivations import pool_lifespan
 from app.errors import register_error_handlers
 from app.middleware import BodyLimit, HeadAsGet, SecurityHeaders
 from app.paths import STATIC_DIR, api_docs_dir, mathjax_dir, plotly_dir
@@ -36,6 +37,7 @@ class LagrangeLab(FastAPI):
 
 
 app = LagrangeLab(
+    lifespan=pool_lifespan,  # the worker pool starts warm before the first request
     title="Lagrange Lab",
     version=__version__,
     summary="Step-by-step Lagrangian mechanics: from a scene to its equations of motion.",

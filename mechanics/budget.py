@@ -1,42 +1,26 @@
-"""Run untrusted work (a posted scene's derivation) in a child process with a time and memory cap.
+"""What a budget is, and what happens past it: the refusal, the memory cap, exceptions that travel.
 
-A spec can be small and still make sympy grind for minutes or swell to gigabytes; a thread cannot be
-stopped, a process can. The child is forked, so it inherits the already-imported engine (sympy
-costs a second to import) and starts in milliseconds; its result comes back pickled through a pipe.
+A spec or an answer can be small and still make sympy grind for minutes or swell to gigabytes; a
+thread cannot be stopped, a process can. The work runs in a warm worker process (mechanics/pool.py)
+which is killed at the time cap; the memory cap is the worker's address-space limit, set afresh
+for each job, so a job past it fails with MemoryError inside the worker, reported as
+``BudgetExceeded("size", ...)``.
 
-    >>> run_with_budget(pow, 2, 10, seconds=5)
-    1024
+    >>> str(BudgetExceeded("time", "derivation took longer than 20 s"))
+    'derivation took longer than 20 s'
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
 import pickle
 import resource
-import signal
-import threading
-import time
-import traceback
-from collections.abc import Callable
-from multiprocessing.connection import Connection
-from typing import Any, Literal, TypeVar
+from typing import Any, Literal
 
-__all__ = ["BudgetExceeded", "run_with_budget", "DEFAULT_MEMORY_BYTES"]
+__all__ = ["BudgetExceeded", "DEFAULT_MEMORY_BYTES", "limit_memory", "lift_memory_limit"]
 
-#: Address space the child may add to what it inherits: generous for any honest scene.
+#: Address space one job may add to what its worker holds when it starts: generous for any honest
+#: scene or answer.
 DEFAULT_MEMORY_BYTES = 2 * 1024**3
-#: After SIGTERM, how long the child gets before SIGKILL.
-_GRACE_SECONDS = 1.0
-
-_FORK = multiprocessing.get_context("fork")
-#: multiprocessing's bookkeeping of children is not thread-safe; routes run in a threadpool.
-_START_LOCK = threading.Lock()
-#: At most one derivation per core at once, so a burst of posts cannot take every core and
-#: every gigabyte; the rest queue, and the time queued counts against their own budget.
-_SLOTS = threading.BoundedSemaphore(max(1, os.cpu_count() or 1))
-
-T = TypeVar("T")
 
 
 class BudgetExceeded(RuntimeError):
@@ -54,129 +38,32 @@ class BudgetExceeded(RuntimeError):
         return (type(self), (self.kind, self.message))
 
 
-def run_with_budget(
-    fn: Callable[..., T],
-    *args: Any,
-    seconds: float,
-    memory_bytes: int = DEFAULT_MEMORY_BYTES,
-    **kwargs: Any,
-) -> T:
-    """Return ``fn(*args, **kwargs)`` computed in a forked child, or raise.
+def limit_memory(extra_bytes: int) -> None:
+    """Cap this process's address space at what it holds now plus ``extra_bytes``.
 
-    Raises BudgetExceeded("time") past ``seconds`` (the child is terminated, then killed, and
-    always reaped), BudgetExceeded("size") if the child runs out of its ``memory_bytes``, and
-    otherwise re-raises whatever the child raised, with its type and attributes intact.
-    """
-    deadline = time.monotonic() + seconds
-    if not _SLOTS.acquire(timeout=seconds):
-        raise BudgetExceeded("time", f"the server is busy: no derivation slot within {seconds:g} s")
-    try:
-        return _run_in_child(fn, args, kwargs, seconds, deadline, memory_bytes)
-    finally:
-        _SLOTS.release()
-
-
-def _run_in_child(
-    fn: Callable[..., T],
-    args: tuple,
-    kwargs: dict,
-    seconds: float,
-    deadline: float,
-    memory_bytes: int,
-) -> T:
-    receiver, sender = _FORK.Pipe(duplex=False)
-    child = _FORK.Process(
-        target=_child_main, args=(sender, memory_bytes, fn, args, kwargs), daemon=True
-    )
-    payload, answered = None, False
-    try:
-        with _START_LOCK:
-            child.start()
-        sender.close()  # only the child writes: its exit then reads as EOF here
-        answered = receiver.poll(max(0.0, deadline - time.monotonic()))
-        if not answered:
-            raise BudgetExceeded(
-                "time",
-                f"derivation took longer than {seconds:g} s; simplify the scene "
-                "(fewer coordinates or bodies, simpler expressions) and try again",
-            )
-        try:
-            payload = receiver.recv_bytes()
-        except EOFError:
-            pass  # it died without a word: reported below, once its exit code is known
-    finally:
-        receiver.close()
-        exitcode = _reap(child, patience=_GRACE_SECONDS if answered else 0.0)
-    if payload is None:
-        raise RuntimeError(f"derivation process died without an answer (exit code {exitcode})")
-    status, value = pickle.loads(payload)
-    if status == "ok":
-        return value
-    raise _rebuild(value)
-
-
-def _reap(child: Any, patience: float) -> int | None:
-    """Wait ``patience`` s for the child to exit, then terminate (and kill) it, and reap it, so no
-    zombie outlives the call. Returns its exit code.
-
-    Under the start lock: ``Process.start`` polls every other child, and two threads waiting on
-    the same pid at once would leave one of them unsure whether it exited.
-    """
-    with _START_LOCK:
-        child.join(patience)
-        if child.is_alive():
-            child.terminate()
-            child.join(_GRACE_SECONDS)
-            if child.is_alive():
-                child.kill()
-        child.join()
-        exitcode = child.exitcode
-        child.close()
-    return exitcode
-
-
-def _child_main(
-    sender: Connection, memory_bytes: int, fn: Callable[..., Any], args: tuple, kwargs: dict
-) -> None:
-    # The parent may be uvicorn, whose SIGTERM handler only asks the server to stop: restore the
-    # default so that terminate() ends this child.
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    try:
-        _limit_memory(memory_bytes)
-        payload = pickle.dumps(("ok", fn(*args, **kwargs)), pickle.HIGHEST_PROTOCOL)
-    except MemoryError:
-        error = BudgetExceeded(
-            "size",
-            f"derivation needed more than {memory_bytes / 1024**3:g} GiB of memory; "
-            "simplify the scene and try again",
-        )
-        payload = pickle.dumps(("error", _portable(error)))
-    except BaseException as exc:  # everything, even SystemExit, goes back to the parent
-        exc.add_note("in the budgeted child process:\n" + traceback.format_exc())
-        payload = pickle.dumps(("error", _portable(exc)))
-    sender.send_bytes(payload)
-    sender.close()
-
-
-def _limit_memory(extra_bytes: int) -> None:
-    """Cap the address space at what the fork inherited plus ``extra_bytes``.
-
-    Counting from the inherited size (not from zero) keeps a parent with a large virtual footprint
-    (thread stacks, BLAS buffers) from leaving its child unable to allocate anything at all.
+    Counting from the current size (not from zero) keeps a worker with a large virtual footprint
+    (thread stacks, BLAS buffers, its caches) from being unable to allocate anything at all, and
+    gives every job the same headroom however much earlier jobs cached.
     """
     try:
         with open("/proc/self/statm") as f:
-            inherited = int(f.read().split()[0]) * resource.getpagesize()
+            current = int(f.read().split()[0]) * resource.getpagesize()
     except OSError:  # no /proc (macOS): count from zero, the cap still applies
-        inherited = 0
-    limit = inherited + extra_bytes
+        current = 0
     _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    limit = current + extra_bytes
     if hard != resource.RLIM_INFINITY:
         limit = min(limit, hard)
     resource.setrlimit(resource.RLIMIT_AS, (limit, hard))
 
 
-def _portable(exc: BaseException) -> tuple[type, tuple, dict]:
+def lift_memory_limit() -> None:
+    """Back to the hard limit between jobs (the soft limit may be raised up to it again)."""
+    _, hard = resource.getrlimit(resource.RLIMIT_AS)
+    resource.setrlimit(resource.RLIMIT_AS, (hard, hard))
+
+
+def portable(exc: BaseException) -> tuple[type, tuple, dict]:
     """An exception as (type, args, attributes): survives classes whose __init__ takes other
     arguments than their ``args`` (plain pickling calls ``type(*args)`` and breaks on those)."""
     state = (type(exc), exc.args, dict(vars(exc)))
@@ -187,7 +74,8 @@ def _portable(exc: BaseException) -> tuple[type, tuple, dict]:
         return (RuntimeError, (f"{type(exc).__name__}: {exc}",), {})
 
 
-def _rebuild(state: tuple[type, tuple, dict]) -> BaseException:
+def rebuild(state: tuple[type, tuple, dict]) -> BaseException:
+    """The exception `portable` described, with its type and attributes."""
     cls, args, attributes = state
     exc = cls.__new__(cls, *args)
     exc.args = args

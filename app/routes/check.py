@@ -2,18 +2,12 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Request
 
 from app.derivations import on_scene
 from app.schemas import CheckRequest, CheckResponse, Message, ValidationErrors
 
 router = APIRouter(prefix="/api/v1", tags=["check"])
-
-
-def _check(derivation, quantity: str, answer: str, coordinate: str | None, reveal: bool) -> dict:
-    from mechanics.check import check
-
-    return check(derivation, quantity, answer, coordinate).to_json(reveal)
 
 
 @router.post(
@@ -23,13 +17,24 @@ def _check(derivation, quantity: str, answer: str, coordinate: str | None, revea
     responses={
         404: {"model": Message, "description": "Unknown scene_id."},
         422: {"model": ValidationErrors, "description": "Unparseable answer or bad field."},
+        503: {"model": Message, "description": "The check ran past its time budget."},
     },
     summary="Check a student's answer",
 )
-def post_check(request: CheckRequest) -> dict:
+def post_check(request: CheckRequest, http: Request) -> dict:
     """Equivalence at random states backed by symbolic simplification; feedback names the
     missing or extra term, a wrong factor or sign, swapped parameters, q mixed with q̇, and terms
     whose units cannot belong to the quantity."""
+    from mechanics.jobs import answer_check
+
     return on_scene(
-        request, _check, request.quantity, request.answer, request.coordinate, request.reveal
+        http,
+        request,
+        answer_check,
+        request.quantity,
+        request.answer,
+        request.coordinate,
+        request.reveal,
+        what="checking this answer",
+        advice="write it more simply (as the notes would) and try again",
     )

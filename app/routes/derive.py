@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter, Response
+from fastapi import APIRouter, Request, Response
 
 from app import derivations
 from app.routes.scenes import unknown_scene
@@ -21,7 +21,7 @@ router = APIRouter(prefix="/api/v1", tags=["derive"])
     },
     summary="Derive the equations of motion",
 )
-def post_derive(request: DeriveRequest) -> Response:
+def post_derive(request: DeriveRequest, http: Request) -> Response:
     """Kinematics, energies, generalized forces, Lagrange's equations, the mass-matrix form and
     the conserved quantities, each as a step with prose, LaTeX and plain text.
 
@@ -33,5 +33,5 @@ def post_derive(request: DeriveRequest) -> Response:
         if body is None:
             raise unknown_scene(request.scene_id)
     else:
-        body = derivations.posted_json(request.scene)
+        body = derivations.posted_json(http, request.scene)
     return Response(content=body, media_type="application/json")

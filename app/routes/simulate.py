@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import math
 
-from fastapi import APIRouter, Response
+from fastapi import APIRouter, Request, Response
 
-from app.derivations import derive_seconds
+from app.derivations import in_pool, posted_key
 from app.responses import ORJSONResponse
 from app.routes.scenes import unknown_scene
 from app.schemas import Message, MethodOut, SimulateRequest, SimulateResponse, ValidationErrors
-from mechanics.budget import run_with_budget
 from mechanics.scenes import scene_ids
-from mechanics.spec import parse_spec
 
 router = APIRouter(prefix="/api/v1", tags=["simulate"])
 
@@ -27,7 +25,7 @@ router = APIRouter(prefix="/api/v1", tags=["simulate"])
     },
     summary="Simulate a scene",
 )
-def post_simulate(request: SimulateRequest) -> Response:
+def post_simulate(request: SimulateRequest, http: Request) -> Response:
     """Integrate, then report the trajectory with its cost (steps, RHS evaluations, wall time)
     and accuracy (energy error or energy balance, momentum drift), and warnings in plain words.
     """
@@ -41,11 +39,10 @@ def post_simulate(request: SimulateRequest) -> Response:
             raise unknown_scene(request.scene_id)
         result = simulate(scene_id=request.scene_id, request=options)
     else:
-        document = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
-        parse_spec(document)
-        result = run_with_budget(
-            simulate, scene=document, request=options, seconds=derive_seconds()
-        )
+        from mechanics.jobs import simulation
+
+        key = posted_key(request.scene)
+        result = in_pool(http, simulation, key, options, affinity=key, what="simulating this scene")
     return ORJSONResponse(result)  # NaN/inf become null, as _finite did
 
 
