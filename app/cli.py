@@ -7,6 +7,7 @@ a laptop, and production runs the same command with ``--host 0.0.0.0 --workers N
 from __future__ import annotations
 
 import argparse
+import os
 from functools import partial
 
 import uvicorn
@@ -26,6 +27,13 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
     serve.add_argument("--reload", action="store_true", help="restart when a source file changes")
     serve.add_argument(
+        "--pool-workers",
+        type=int,
+        default=None,
+        help="warm processes per worker for sympy work on user input "
+        "(default: cores / workers, at least 2)",
+    )
+    serve.add_argument(
         "--timeout-keep-alive",
         type=float,
         default=5,
@@ -41,6 +49,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def pool_workers(requested: int | None, workers: int) -> None:
+    """Size each server process's pool (app/derivations.py) through its environment variable,
+    which uvicorn's worker processes inherit: as asked, else the cores shared among the workers,
+    at least 2 (so one busy client never holds them all), unless the variable is already set."""
+    if requested is not None:
+        os.environ["LAGRANGE_LAB_POOL_WORKERS"] = str(requested)
+    else:
+        share = max(2, (os.cpu_count() or 1) // workers)
+        os.environ.setdefault("LAGRANGE_LAB_POOL_WORKERS", str(share))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script and of ``python -m app``; returns the exit status."""
     parser = build_parser()
@@ -52,6 +71,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("--workers must be at least 1")
     if args.reload and args.workers > 1:
         parser.error("--reload runs a single worker; drop --workers")
+    if args.pool_workers is not None and args.pool_workers < 1:
+        parser.error("--pool-workers must be at least 1")
+    pool_workers(args.pool_workers, args.workers)
     uvicorn.run(
         "app.main:app",
         host=args.host,
