@@ -19,6 +19,7 @@ one. Its size and per-client limit come from the environment:
 
 from __future__ import annotations
 
+import json
 import logging
 import os
 import threading
@@ -168,11 +169,20 @@ def scene_json(scene_id: str) -> bytes | None:
 
 
 def posted_json(http: Request, scene: SceneSpec) -> bytes:
-    """The derivation of a posted scene as JSON bytes, computed in the pool."""
+    """The derivation of a posted scene as JSON bytes: from the shared cache (memory, disk or
+    Redis; a posted copy of a built-in scene is the same entry), else computed once in the pool."""
+    from mechanics.derive import derive_cached
     from mechanics.jobs import derivation_json
 
     key = posted_key(scene)
-    return _encode(in_pool(http, derivation_json, key, affinity=key, what="deriving this scene"))
+    return _encode(
+        derive_cached(
+            json.loads(key),
+            compute=lambda: in_pool(
+                http, derivation_json, key, affinity=key, what="deriving this scene"
+            ),
+        )
+    )
 
 
 def _encode(result: dict[str, Any]) -> bytes:
@@ -192,4 +202,21 @@ def on_scene(
     else:
         scene_id, key = None, posted_key(request.scene)
     affinity = scene_id or key
-    return in_pool(http, job, scene_id, key, *args, affinity=affinity, what=what, advice=advice)
+
+    def compute() -> Any:
+        return in_pool(http, job, scene_id, key, *args, affinity=affinity, what=what, advice=advice)
+
+    store = RESULT_STORES.get(getattr(job, "__name__", ""))
+    if store is None:
+        return compute()
+    from mechanics import cache
+    from mechanics.derive import derivation_key, scene_key
+
+    scene = scene_key(scene_id) if scene_id is not None else derivation_key(json.loads(key))
+    return cache.get_or_compute(store, {**scene, "job": store, "args": list(args)}, compute)
+
+
+#: Per-scene results worth sharing (same scene, same arguments, same answer), by the job that
+#: computes them: a class of 200 asks for the same equilibria and types the same answers.
+#: Refusals and budget errors are raised, never stored.
+RESULT_STORES = {"equilibria_json": "equilibria", "newton": "newton", "answer_check": "check"}

@@ -9,6 +9,7 @@ a simulation compiles from are kept in memory per process.
 from __future__ import annotations
 
 import functools
+import json
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -128,6 +129,18 @@ def derive(spec: SceneSpec | dict) -> dict[str, Any]:
 def derivation_of_scene(scene_id: str, branches: tuple[tuple[int, int], ...] = ()) -> Derivation:
     """The sympy-level derivation of a built-in scene, once per process (and branch variant)."""
     return derive_model(parse_spec(load_scene(scene_id)), dict(branches) or None)
+
+
+def spec_text(document: dict) -> str:
+    """A posted spec as canonical JSON text: equal specs, equal keys (caches, pool affinity)."""
+    return json.dumps(document, sort_keys=True, separators=(",", ":"))
+
+
+@functools.lru_cache(maxsize=32)
+def derivation_of_spec(text: str, branches: tuple[tuple[int, int], ...] = ()) -> Derivation:
+    """The sympy-level derivation of a posted spec (by `spec_text`), once per process: its
+    derive, check, equilibria and newton requests and its compiled simulation share it."""
+    return derive_model(json.loads(text), dict(branches) or None)
 
 
 def derivation_key(spec: SceneSpec | dict) -> dict[str, Any]:

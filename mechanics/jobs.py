@@ -13,29 +13,25 @@ imported.
 
 from __future__ import annotations
 
-import functools
 import json
 from typing import Any
 
 from mechanics.check import check
-from mechanics.derive import Derivation, derivation_of_scene, derive_model
+from mechanics.derive import Derivation, derivation_of_scene, derivation_of_spec, spec_text
 from mechanics.equilibria import equilibria
 from mechanics.newton import newton_json
 from mechanics.simulate import SimulationRequest, simulate
 
-#: How many posted specs' derivations a worker keeps (least recently used go first).
-POSTED_DERIVATIONS = 32
-
 
 def spec_key(document: dict) -> str:
     """A posted spec's canonical JSON: its cache key and its affinity in the pool."""
-    return json.dumps(document, sort_keys=True, separators=(",", ":"))
+    return spec_text(document)
 
 
-@functools.lru_cache(maxsize=POSTED_DERIVATIONS)
 def posted_derivation(key: str) -> Derivation:
-    """The sympy-level derivation of a posted spec, once per worker."""
-    return derive_model(json.loads(key))
+    """The sympy-level derivation of a posted spec, once per worker (shared with its compiled
+    simulation: mechanics/numeric.py asks the same cache)."""
+    return derivation_of_spec(key)
 
 
 def derivation_of(scene_id: str | None, key: str | None) -> Derivation:

@@ -9,7 +9,6 @@ where numpy on scalars costs several times that. Everything evaluated along a fi
 from __future__ import annotations
 
 import functools
-import json
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -19,7 +18,7 @@ import sympy as sp
 from sympy.physics.vector import Vector
 
 from mechanics import native
-from mechanics.derive import Derivation, derivation_of_scene, derive_model
+from mechanics.derive import Derivation, derivation_of_scene, derivation_of_spec, spec_text
 from mechanics.model import T as t
 from mechanics.spec import SpecError
 from mechanics.steps import partial
@@ -296,13 +295,14 @@ def compiled_scene(scene_id: str, branches: Branches = ()) -> CompiledScene:
 
 
 @functools.lru_cache(maxsize=32)
-def _compiled_spec(spec_json: str, branches: Branches = ()) -> CompiledScene:
-    return compile_derivation(derive_model(json.loads(spec_json), dict(branches) or None))
+def _compiled_spec(text: str, branches: Branches = ()) -> CompiledScene:
+    return compile_derivation(derivation_of_spec(text, branches))
 
 
 def compiled_spec(spec: dict, branches: Branches = ()) -> CompiledScene:
-    """A posted spec compiled once per distinct spec (keyed by its canonical JSON)."""
-    return _compiled_spec(json.dumps(spec, sort_keys=True), branches)
+    """A posted spec compiled once per distinct spec (keyed by its canonical JSON), from the same
+    derivation its derive, check and equilibria requests use."""
+    return _compiled_spec(spec_text(spec), branches)
 
 
 #: Past 1e±30 a value is more likely a units mistake than physics: such values are named first

@@ -117,7 +117,8 @@ def test_derive_a_posted_scene(client):
 def test_a_posted_scene_past_its_time_budget_is_503(client, monkeypatch):
     monkeypatch.setenv("LAGRANGE_LAB_DERIVE_SECONDS", "0.001")
     # a spec no worker derived before: a derivation kept from an earlier test answers in < 1 ms
-    response = client.post("/api/v1/derive", json={"scene": scene_with(title="Never seen")})
+    unseen = scene_with(title=f"Never seen {time.time_ns()}")
+    response = client.post("/api/v1/derive", json={"scene": unseen})
     assert response.status_code == 503
     (problem,) = response.json()["detail"]
     assert problem["field"] == "scene" and "time budget" in problem["message"]
@@ -286,9 +287,11 @@ def test_a_real_server_is_fast_warm_and_survives_bad_and_runaway_requests(tmp_pa
             # ~1.5 ms on an idle machine (python -m mechanics.bench derive measures it); the
             # bound here only proves the warm path is a lookup, not a derivation (~100 ms+)
             assert statistics.median(timings) < 0.05, timings
+            # a spec never derived before: a cached derivation needs no budget (it answers at once)
+            unseen = scene_with(title=f"Runaway {time.time_ns()}")
             for _ in range(3):
                 start = time.perf_counter()
-                assert http.post("/api/v1/derive", json={"scene": PENDULUM}).status_code == 503
+                assert http.post("/api/v1/derive", json={"scene": unseen}).status_code == 503
                 # the pool kills the worker at its deadline: no grace period to wait out
                 assert time.perf_counter() - start < 3.0
             assert http.post("/api/v1/derive", json={}).status_code == 422

@@ -188,7 +188,9 @@ def test_a_worker_killed_mid_request_gives_503_and_the_pool_recovers(client, mon
 
 def test_the_budget_applies_per_request(client, monkeypatch):
     monkeypatch.setenv("LAGRANGE_LAB_DERIVE_SECONDS", "0.001")
-    response = client.post("/api/v1/derive", json={"scene": PENDULUM})
+    # a spec never derived before: a cached derivation needs no budget (it answers at once)
+    unseen = {**PENDULUM, "title": f"Never seen {time.time_ns()}"}
+    response = client.post("/api/v1/derive", json={"scene": unseen})
     assert response.status_code == 503
     assert "time budget" in message(response)
     monkeypatch.setenv("LAGRANGE_LAB_DERIVE_SECONDS", "30")
