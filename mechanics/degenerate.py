@@ -36,6 +36,7 @@ def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> list[i
     rng = random.Random(0)
     positive = set(model.spec.positive_coordinates)
     idle = set(range(n))
+    finite = 0
     for _ in range(PROBES):
         q = [
             rng.uniform(0.5, 1.5) if name in positive else rng.uniform(-1.3, 1.3)
@@ -50,17 +51,50 @@ def singular_everywhere(M: sp.Matrix, model, values: dict[str, float]) -> list[i
         m = m.reshape(n, n)
         if not np.all(np.isfinite(m)):
             continue
+        finite += 1
         eig = np.linalg.eigvalsh((m + m.T) / 2)
         if eig.min() > 1e-14 * max(abs(eig).max(), 1e-300):
             return None
         idle &= {j for j in range(n) if not np.any(m[j])}
+    if not finite:
+        raise SpecError([_overflowing(values)])
     return sorted(idle)
 
 
-def check_mass_matrix(derivation) -> None:
-    """Raise SpecError naming the parameters (or bodies) that leave M singular everywhere."""
+def _overflowing(values: dict[str, float]) -> dict[str, str]:
+    """M is not a finite double anywhere: name the parameters far from 1 (a units mistake)."""
+    far = [k for k, v in values.items() if v and abs(np.log10(abs(v))) > 30]
+    return {
+        "field": ", ".join(f"parameters.{k}" for k in far) or "parameters",
+        "message": "the mass matrix overflows double precision at these parameters: pick units "
+        "in which the numbers are nearer 1",
+    }
+
+
+def check_masses(model, values: dict[str, float]) -> None:
+    """Every body's mass, evaluated at these parameters, must be a positive number: a mass
+    written as an expression ("m - 2", "-1*m") escapes the per-parameter sign checks."""
+    numbers = {model.params[k]: sp.Float(v) for k, v in values.items()}
+    errors = []
+    for i, b in enumerate(model.bodies):
+        try:
+            mass = float(b.mass.xreplace(numbers))
+        except (TypeError, ValueError):
+            continue  # depends on a coordinate or t: the mass matrix check decides
+        if not mass > 0:
+            alone = str(b.mass) if b.mass in model.params.values() else None
+            field = f"parameters.{alone}" if alone else f"bodies[{i}].mass"
+            errors.append({"field": field, "message": f"must be > 0: {b.name}'s mass is {mass:g}"})
+    if errors:
+        raise SpecError(errors)
+
+
+def check_mass_matrix(derivation, values: dict[str, float] | None = None) -> None:
+    """Raise SpecError naming the bodies or parameters that leave M singular everywhere, at the
+    spec's parameters or the ``values`` a request gives."""
     m, M = derivation.model, derivation.work.mass_matrix
-    values = {k: float(v) for k, v in m.spec.parameters.items()}
+    values = {k: float(v) for k, v in {**m.spec.parameters, **(values or {})}.items()}
+    check_masses(m, values)
     idle = singular_everywhere(M, m, values)
     if idle is None:
         return

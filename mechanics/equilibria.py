@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
+from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import T as t
@@ -209,6 +210,7 @@ def _checked(d: Derivation, parameters: dict[str, float]) -> dict[str, float]:
             errors.append({"field": f"parameters.{name}", "message": "must be ≥ 0"})
     if errors:
         raise SpecError(errors)
+    check_mass_matrix(d, parameters)  # a zero mass has no equilibria to speak of: 422
     return {**m.spec.parameters, **parameters}
 
 

@@ -296,6 +296,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         l0 = expr(s.rest_length, f"springs[{i}].rest_length")
         d = positions[s.b] - positions[s.a]
         name = s.name or f"spring{i + 1}"
+        _has_length(d, f"springs[{i}].b")
         if l0.is_zero:  # ½ k d·d: smooth everywhere, no length to take a root of
             length, branch, sign = _length_of(d.dot(d))
             springs.append(SpringInfo(name, s.a, s.b, k, l0, length, k * d.dot(d) / 2))
@@ -312,6 +313,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         # ê d·d = (d·ê) d, so no square root (and no direction to lose at zero length on a line).
         c = expr(dmp.c, f"dampers[{i}].c")
         d = positions[dmp.b] - positions[dmp.a]
+        _has_length(d, f"dampers[{i}].b")
         rel = positions[dmp.b].dt(N) - positions[dmp.a].dt(N)
         along = -c * rel.dot(d) / _tidy_square(d.dot(d)) * d
         name = dmp.name or f"damper{i + 1}"
@@ -391,12 +393,24 @@ def _unit(v: list[float] | None) -> tuple[float, float, float] | None:
     if v is None:
         return None
     v = [*v, 0.0][:3]
+    big = max(abs(c) for c in v)  # scaled first: 1e-200 or 1e200 squared leaves double range
+    v = [c / big for c in v]
     norm = sum(c * c for c in v) ** 0.5
     return (v[0] / norm, v[1] / norm, v[2] / norm)
 
 
 class _Unresolved(Exception):
     pass
+
+
+def _has_length(d: Vector, field: str) -> None:
+    """Refuse a spring or damper whose ends are always at the same place: it has no direction."""
+    if _tidy_square(d.dot(d)) == 0:
+        from mechanics.spec import SpecError
+
+        raise SpecError(
+            [{"field": field, "message": "both ends are always at the same place: no length"}]
+        )
 
 
 def _tidy_square(d2: sp.Expr) -> sp.Expr:

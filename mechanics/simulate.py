@@ -34,8 +34,9 @@ MAX_T_END = 1000.0
 #: samples over 1 ms of a stiff spring (fps = 1e5) is a fair request.
 MAX_SAMPLES = 20_001
 MAX_WALL_TIME = 10.0
-#: Springs along a line whose side of the anchor a request may flip (one re-derivation each).
-MAX_BRANCH_FLIPS = 17
+#: Derivations one request may ask for: its own and the variant with springs on the other side of
+#: their anchors (all flipped at once; a second flip means the state moved, which it cannot).
+MAX_BRANCH_FLIPS = 2
 MAX_FIXED_STEPS = 2_000_000
 #: Above this relative energy error the run carries a warning.
 ENERGY_WARNING = 1e-3
@@ -129,10 +130,13 @@ def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any)
     n, m = c.n, c.derivation.model
     errors = []
     names = ", ".join(f"initial.{q}" for q in c.coordinates if q in req.initial) or "initial"
+    flips = {}
     for i, fn in c.branch_values.items():
         (p,) = _at(fn, 0.0, y0, n, params)
         spring = m.springs[i]
-        if abs(p) <= 1e-12 * max(1.0, float(np.max(np.abs(y0[:n]), initial=0.0))):
+        # the scale of p: the coordinates it is made of (not an unrelated one's size)
+        own = [abs(y0[j]) for j, q in enumerate(m.q) if spring.branch.has(q)]
+        if not abs(p) > 1e-12 * max([1.0, *own]):
             errors.append(
                 {
                     "field": names,
@@ -141,7 +145,9 @@ def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any)
                 }
             )
         elif p < 0:
-            raise _OtherBranch(i, -spring.sign)
+            flips[i] = -spring.sign
+    if flips and not errors:
+        raise _OtherBranch(flips)  # every spring on its other side at once: one re-derivation
     mass = np.array(_at(c.mass_matrix, 0.0, y0, n, params)).reshape(n, n)
     overflow = _overflow(c, params, y0, mass, moves=False)
     if overflow:
@@ -154,8 +160,17 @@ def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any)
     if errors:
         raise SpecError(errors)
     overflow = _overflow(c, params, y0, mass, moves=req.t_end > 0)
+    if overflow == DIVISION_BY_ZERO:
+        message = (
+            "the equations divide by zero in this state (a damper or spring at zero length, "
+            "where its direction is undefined, or a coordinate singularity): start elsewhere"
+        )
+        raise SpecError([{"field": names, "message": message}])
     if overflow:
         raise SpecError([_too_large(c, params, req, overflow)])
+
+
+DIVISION_BY_ZERO = "division by zero"
 
 
 def _overflow(
@@ -178,6 +193,8 @@ def _overflow(
     try:
         with np.errstate(all="ignore"):
             accel = np.asarray(c.rhs(params)(0.0, np.asarray(y0, dtype=float)), dtype=float)
+    except ZeroDivisionError:
+        return DIVISION_BY_ZERO
     except _PHYSICAL:  # math.exp, a Python float's ** or / past the range of a double
         return "the accelerations q̈"
     return "" if np.all(np.isfinite(accel)) else "the accelerations q̈"
@@ -215,10 +232,10 @@ def _singular_mass(c: CompiledScene, params: list[float], names: str) -> dict[st
 
 
 class _OtherBranch(Exception):
-    """The state lies on the other side of a spring's anchor: derive that variant."""
+    """The state lies on the other side of some springs' anchors: derive that variant."""
 
-    def __init__(self, index: int, sign: int) -> None:
-        self.index, self.sign = index, sign
+    def __init__(self, flips: dict[int, int]) -> None:
+        self.flips = flips
 
 
 def _run(
@@ -272,10 +289,15 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     n_samples = int(math.floor(req.t_end * req.fps + 1e-9)) + 1
     t_eval = np.linspace(0.0, (n_samples - 1) / req.fps, n_samples)
     refuse_passed_stops(c, params, y0)
-    run = _run(c, params, y0, t_eval, req, req.rtol, req.atol)
+    at_start = stopped_at_start(c, params, y0)
+    run = _run(c, params, y0, t_eval[:1] if at_start else t_eval, req, req.rtol, req.atol)
     warnings: list[str] = [run.note] if run.note else []
     raw = run
-    stop = first_stop(c, run, params, req, run.watch)
+    if at_start is not None:
+        run.status, run.message = "stopped", f"{at_start.name} at t = 0 s"
+    stop = first_stop(c, run, params, req, run.watch) if at_start is None else None
+    if at_start is not None:
+        stop = StopEvent(at_start.name, at_start.message, 0.0, run)
     if stop is not None:
         run = stop.run
         warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
@@ -390,32 +412,42 @@ class StopWatch:
     values meets 0.
     """
 
-    NEAR_ZERO = 1e-9
+    NEAR_ZERO = 1e-9  # relative to the largest |value| the stop has had in the run
 
     def __init__(self, c: CompiledScene, params: list[float], y0: np.ndarray) -> None:
         self.c, self.params = c, params
         state = (0.0, np.array(y0, dtype=float), self._values(0.0, np.asarray(y0)))
         self.last, self.before_last = state, None
+        self.scale = [abs(v) if math.isfinite(v) else 0.0 for v in state[2]]
         #: (stop index, t before, y before, t after, y after, how: "crossed" | "secant")
         self.hit: tuple[int, float, np.ndarray, float, np.ndarray, str] | None = None
 
     def _values(self, t: float, y: np.ndarray) -> list[float]:
         n = self.c.n
         q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
-        return [float(np.asarray(st.value(t, *q, *qd, *self.params)[0])) for st in self.c.stops]
+        with np.errstate(all="ignore"):
+            return [float(np.asarray(st.value(t, *q, *qd, *self.params)[0])) for st in self.c.stops]
 
     def guard(self, stop: Any, t: float, y: np.ndarray) -> bool:
+        """Does the stop apply here? An undefined (NaN) guard counts as applying: a model whose
+        condition cannot even be evaluated has stopped holding."""
         if stop.only_if is None:
             return True
         n = self.c.n
         q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
-        return float(np.asarray(stop.only_if(t, *q, *qd, *self.params)[0])) >= 0
+        g = float(np.asarray(stop.only_if(t, *q, *qd, *self.params)[0]))
+        return not g < 0
 
     def __call__(self, t: float, y: np.ndarray) -> bool:
         values = self._values(t, y)
         t1, y1, v1 = self.last
         for i, stop in enumerate(self.c.stops):
             before, now = v1[i], values[i]
+            if math.isfinite(now):
+                self.scale[i] = max(self.scale[i], abs(now))
+            if math.isnan(now) and not math.isnan(before):  # the condition became undefined
+                self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
+                return True
             if stop.crossing == "falls":
                 if before > 0 >= now and self.guard(stop, t, y):
                     self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
@@ -424,7 +456,8 @@ class StopWatch:
             if np.sign(before) != np.sign(now) and before != 0 and self.guard(stop, t, y):
                 self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
                 return True
-            if 0 < abs(now) <= self.NEAR_ZERO and self.guard(stop, t, y):
+            near = 0 < abs(now) <= self.NEAR_ZERO * self.scale[i]
+            if near and self.guard(stop, t, y):
                 self.hit = (i, t1, y1, t, np.array(y, dtype=float), "secant")
                 return True
             if self.before_last is not None:
@@ -446,11 +479,34 @@ class StopWatch:
         """
         i, t0, y0, t1, y1, _ = self.hit
         v0, v1 = self._values(t0, y0)[i], self._values(t1, y1)[i]
+        if math.isnan(v1):  # the condition became undefined: where, by bisection
+            return self.c.stops[i], *_first_undefined(self.c, self.c.stops[i], params, t0, y0, t1)
+        if not math.isfinite(v0 - v1):
+            return self.c.stops[i], t1, np.array(y1, dtype=float)
         t_stop = t1 if v0 == v1 else t1 + v1 * (t1 - t0) / (v0 - v1)
         t_stop = min(max(t_stop, t0), t1 + (t1 - t0))
         crossed = np.sign(v0) != np.sign(v1)
         start, state = (t0, y0) if crossed or t_stop < t1 else (t1, y1)
         return self.c.stops[i], t_stop, _advance(self.c, params, start, state, t_stop)
+
+
+def _first_undefined(c: CompiledScene, stop: Any, params, t0: float, y0: np.ndarray, t1: float):
+    """Where a stop's condition first becomes undefined (NaN) in (t0, t1]: bisection on states
+    integrated from (t0, y0), where it was defined."""
+    n, lo, hi = c.n, t0, t1
+    y_hi = _advance(c, params, t0, y0, t1)
+    for _ in range(60):
+        if hi - lo <= 1e-12 * max(1.0, abs(hi)):
+            break
+        mid = (lo + hi) / 2
+        y = _advance(c, params, t0, y0, mid)
+        with np.errstate(all="ignore"):
+            value = float(np.asarray(stop.value(mid, *y[:n], *y[n : 2 * n], *params)[0]))
+        if math.isnan(value):
+            hi, y_hi = mid, y
+        else:
+            lo = mid
+    return float(hi), y_hi
 
 
 def _advance(c: CompiledScene, params: list[float], t0: float, y0: np.ndarray, t1: float):
@@ -470,6 +526,11 @@ def _watch(c: CompiledScene, params: list[float], y0: np.ndarray) -> StopWatch |
 
 
 def _stop_values(c, stop, t, y, params) -> tuple[np.ndarray, np.ndarray | None]:
+    with np.errstate(all="ignore"):
+        return _stop_values_of(c, stop, t, y, params)
+
+
+def _stop_values_of(c, stop, t, y, params) -> tuple[np.ndarray, np.ndarray | None]:
     n = c.n
     (value,) = evaluate(stop.value, t, y[:, :n].T, y[:, n : 2 * n].T, params)
     guard = None
@@ -498,6 +559,18 @@ def refuse_passed_stops(c: CompiledScene, params: list[float], y0: np.ndarray) -
         raise SpecError(errors)
 
 
+def stopped_at_start(c: CompiledScene, params: list[float], y0: np.ndarray) -> Any | None:
+    """A sign-change stop whose value is exactly 0 at the start, its guard holding (a block at
+    rest where static friction holds it): the model's motion ends before it begins."""
+    for stop in c.stops:
+        if stop.crossing != "any":
+            continue
+        value, guard = _stop_values(c, stop, np.array([0.0]), y0[None, :], params)
+        if value[0] == 0 and (guard is None or not guard[0] < 0):
+            return stop
+    return None
+
+
 def first_stop(
     c: CompiledScene, run: Any, params: list[float], req: Any, watch: StopWatch | None = None
 ) -> StopEvent | None:
@@ -513,13 +586,13 @@ def first_stop(
         found = _locate(c, t_prev, y_prev, t_hit, params, req) if how == "crossed" else None
         stop, t_stop, y_stop = found or watch.secant(params)
         return _cut(run, len(run.t), stop, t_stop, y_stop)
-    k = None
+    k, first = None, None
     if len(run.t) >= 2:
         for stop in c.stops:
             value, guard = _stop_values(c, stop, run.t, run.y, params)
             hit = _crossing(value, stop.crossing, guard)
             if hit is not None and (k is None or hit < k):
-                k = hit
+                k, first = hit, stop
     if k is not None:
         t0, y0, t1 = run.t[k - 1], run.y[k - 1], run.t[k]
     elif run.status != "ok":
@@ -531,6 +604,8 @@ def first_stop(
     else:
         return None
     found = _locate(c, t0, y0, t1, params, req)
+    if found is None and first is not None:  # not located: the condition became undefined
+        found = first, *_first_undefined(c, first, params, t0, y0, t1)
     if found is None:
         return None
     stop, t_stop, y_stop = found
@@ -556,14 +631,17 @@ def _cut(run: Any, k: int, stop: Any, t_stop: float, y_stop: np.ndarray) -> Stop
 
 def _crossing(value: np.ndarray, crossing: str, guard: np.ndarray | None) -> int | None:
     """The first sample index k ≥ 1 at which the condition has been reached since k − 1."""
+    undefined = np.nonzero(np.isnan(value[1:]) & ~np.isnan(value[:-1]))[0] + 1
     if crossing == "falls":
         hits = np.nonzero((value[1:] <= 0) & (value[:-1] > 0))[0] + 1
         if value[0] == 0:
             hits = np.concatenate([np.nonzero(value[1:] < 0)[0][:1] + 1, hits])
     else:
         hits = np.nonzero(np.sign(value[1:]) != np.sign(value[:-1]))[0] + 1
-    for k in np.sort(hits):
-        if guard is None or guard[k] >= 0 or guard[k - 1] >= 0:
+        hits = hits[~np.isnan(value[hits]) & ~np.isnan(value[hits - 1])]
+    for k in np.sort(np.concatenate([hits, undefined])).astype(int):
+        applies = guard is None or not guard[k] < 0 or not guard[k - 1] < 0  # NaN: it applies
+        if applies or k in undefined:
             return int(k)
     return None
 
@@ -596,7 +674,6 @@ def _locate(c, t0, y0, t1, params, req) -> tuple[Any, float, np.ndarray] | None:
         g.direction = -1 if stop.crossing == "falls" else 0
         return g
 
-    events = [event(stop) for stop in c.stops]
     rhs, calls = c.rhs(params), [0]
 
     def budgeted(time: float, y: np.ndarray) -> np.ndarray:
@@ -605,21 +682,37 @@ def _locate(c, t0, y0, t1, params, req) -> tuple[Any, float, np.ndarray] | None:
             raise _LocateBudget
         return rhs(time, y)
 
-    for stop, g in zip(c.stops, events, strict=True):
-        if stop.crossing == "falls" and g(t0, y0) <= 0 and t0 > 0:
-            return stop, float(t0), np.asarray(y0)  # reached on the sample itself
+    def pending(time: float, y: np.ndarray) -> list[int]:
+        """The stops still ahead: a falling stop already at or below 0 (its guard failed, or it
+        is 0 for good) cannot fall again without rising first."""
+        out = []
+        for i, stop in enumerate(c.stops):
+            g = event(stop)(time, y)
+            if stop.crossing == "any" or not g <= 0:
+                out.append(i)
+        return out
+
     start, state = t0, np.asarray(y0, dtype=float)
     for _ in range(_MAX_EVENT_RESTARTS):
+        ahead = pending(start, state)
+        if not ahead:
+            return None
         try:
             with np.errstate(all="ignore"):
                 sol = solve_ivp(
-                    budgeted, (start, t1), state, method=method, rtol=rtol, atol=atol, events=events
+                    budgeted,
+                    (start, t1),
+                    state,
+                    method=method,
+                    rtol=rtol,
+                    atol=atol,
+                    events=[event(c.stops[i]) for i in ahead],
                 )
-        except (_LocateBudget, *_PHYSICAL, ValueError):  # ValueError: an implicit method's
-            return None  # Jacobian past the range of a double (scipy refuses infs in its LU)
+        except (_LocateBudget, ValueError, *_PHYSICAL):
+            return None
         hits = [
             (te[0], i, ye[0])
-            for i, (te, ye) in enumerate(zip(sol.t_events, sol.y_events, strict=True))
+            for i, te, ye in zip(ahead, sol.t_events, sol.y_events, strict=True)
             if len(te)
         ]
         if not hits:
@@ -627,7 +720,8 @@ def _locate(c, t0, y0, t1, params, req) -> tuple[Any, float, np.ndarray] | None:
         t_hit, i, y_hit = min(hits, key=lambda h: h[0])
         stop = c.stops[i]
         q, qd = y_hit[:n].tolist(), y_hit[n : 2 * n].tolist()
-        if stop.only_if is None or float(np.asarray(stop.only_if(t_hit, *q, *qd, *params)[0])) >= 0:
+        guard = np.nan if stop.only_if is None else stop.only_if(t_hit, *q, *qd, *params)[0]
+        if stop.only_if is None or not float(np.asarray(guard)) < 0:
             return stop, float(t_hit), y_hit
         if t_hit >= t1:
             return None
@@ -728,5 +822,5 @@ def simulate(
         try:
             return simulate_compiled(c, req)
         except _OtherBranch as other:
-            branches = {**c.derivation.model.branches, other.index: other.sign}
+            branches = {**c.derivation.model.branches, **other.flips}
     raise SpecError([{"field": "initial", "message": "no derivation matches this state"}])

@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from urllib.parse import urlparse
 
@@ -124,9 +125,17 @@ def test_the_installed_wheel_serves_pages_assets_docs_and_health(installed):
 def test_the_installed_pages_work_offline_under_their_csp(installed):
     """A browser that enforces the CSP (no bypass): the docs list the operations, a scene page
     typesets its math and plots, and nothing is refused, failed or fetched from elsewhere."""
+    problems: list[str] = []
+    # a thread of its own: the session's browser fixture keeps Playwright's event loop running
+    # in the main thread, where a second sync_playwright() refuses to start
+    with ThreadPoolExecutor(1) as pool:
+        pool.submit(_browse_installed, installed, problems).result()
+    assert problems == []
+
+
+def _browse_installed(installed: str, problems: list[str]) -> None:
     from playwright.sync_api import sync_playwright
 
-    problems: list[str] = []
     host = urlparse(installed).netloc
     with sync_playwright() as p:
         browser = p.chromium.launch(
@@ -157,4 +166,3 @@ def test_the_installed_pages_work_offline_under_their_csp(installed):
         page.goto(f"{installed}/")
         page.locator("svg[data-thumb] *").first.wait_for(timeout=30_000)
         browser.close()
-    assert problems == []

@@ -180,7 +180,7 @@ def test_the_wall_time_budget_stops_a_sleeping_rhs_near_the_budget(method):
         ({"parameters": {"zeta": 1.0}}, "parameters.zeta", "unknown parameter"),
         ({"t_end": 1e6}, "t_end", "between"),
         ({"t_end": -1.0}, "t_end", "between"),
-        ({"fps": 0.0}, "fps", "(0,"),
+        ({"fps": 0.0}, "fps", "> 0"),
         ({"method": "rk4"}, "dt", "dt > 0"),
         ({"method": "euler", "dt": 0.0}, "dt", "dt > 0"),
         ({"method": "ode45"}, "method", "unknown method"),
