@@ -409,7 +409,8 @@ def _drift(drift: Drift, name: str, tolerances) -> str:
     if drift.forced:
         text = (
             f"The runs{_tol(tolerances)} drift apart in phase: with one coordinate and no "
-            "explicit time the phase space is a plane, where errors cannot grow exponentially."
+            "explicit time (a phase plane) errors cannot keep growing exponentially (they may "
+            "grow fast for a while, near the top of a swing, but not for good)."
         )
     else:
         text = f"The runs{_tol(tolerances)} drift apart steadily in phase, not exponentially."

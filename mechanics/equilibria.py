@@ -134,10 +134,59 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
+    results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
     steps.append(_stability_step(results, verdicts))
-    if not results:
+    dry = _dry_friction(d)
+    if dry:
+        warnings.append(
+            "Dry friction acts here (a force with the sign of a velocity): at rest it can take "
+            "any value up to its limit, which the forces at q̇ = 0 above leave out. A body at "
+            "rest stays at rest wherever static friction can hold the other forces (|F| ≤ μN)"
+            + (": the scene's stop conditions say where." if m.spec.stops else ".")
+        )
+    if not results and not dry:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _dry_friction(d: Derivation) -> bool:
+    """Does a force depend on the sign (or size) of a velocity, as Coulomb friction does?"""
+    qd = set(d.model.qd)
+    return any(
+        f.args and any(f.args[0].has(v) for v in qd)
+        for Q in d.work.Q
+        for f in sp.sympify(Q).atoms(sp.sign, sp.Abs)
+    )
+
+
+def _inside_the_model(m, results, verdicts, values, warnings):
+    """Leave out equilibria past a declared stop (a mass beyond the pulley, a block off the
+    incline): the equations have them, the system they model does not."""
+    rest = {**dict.fromkeys(m.qd, sp.S.Zero), m.names["t"]: sp.S.Zero}
+    kept, out = [], []
+    declared = [
+        st for st in m.stops[: len(m.spec.stops)] if st.when is not None and st.crossing == "falls"
+    ]
+    for r, v in zip(results, verdicts, strict=True):
+        coordinates = zip(m.coordinate_names, m.q, strict=True)
+        point = {**values, **rest, **{q: sp.Float(r["q"][n]) for n, q in coordinates}}
+        past = []
+        for st in declared:
+            try:
+                value = float(st.when.xreplace(point))  # one pass: q̇(t) before the q(t) in it
+            except (TypeError, ValueError):
+                continue
+            if value < 0:
+                past.append(st.name)
+        (out if past else kept).append((r, v, past))
+    if out:
+        names = sorted({n for _, _, past in out for n in past})
+        warnings.append(
+            f"{len(out)} equilibri{'um' if len(out) == 1 else 'a'} of the equations "
+            f"{'lies' if len(out) == 1 else 'lie'} where "
+            f"the model does not hold (past the stop {', '.join(names)}) and are left out."
+        )
+    return [r for r, _, _ in kept], [v for _, v, _ in kept]
 
 
 _NOT_SMOOTH = (

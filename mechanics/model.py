@@ -451,15 +451,19 @@ def _length_of(
 
 def _reference_sign(base: sp.Expr, spec: SceneSpec, names: dict[str, sp.Expr]) -> int:
     """The sign of p in the spec's own state (parameters, initial values, t = 0); + at p = 0."""
+    number = reference_value(base, spec, names)
+    return -1 if number is not None and number < 0 else 1
+
+
+def reference_value(expr: sp.Expr, spec: SceneSpec, names: dict[str, sp.Expr]) -> float | None:
+    """expr in the spec's own state (its parameters, its initial values or 0, t = 0)."""
     values: dict[sp.Expr, sp.Expr] = {names[k]: sp.Float(v) for k, v in spec.parameters.items()}
     for name in reversed(spec.coordinates):  # velocities before the coordinates inside them
         values[names[f"{name}_dot"]] = sp.Float(spec.initial.get(f"{name}_dot", 0.0))
     for name in spec.coordinates:
         values[names[name]] = sp.Float(spec.initial.get(name, 0.0))
     values[T] = sp.Integer(0)
-    value = base.xreplace(values)
     try:
-        number = float(value)
+        return float(expr.xreplace(values))
     except (TypeError, ValueError):
-        return 1
-    return -1 if number < 0 else 1
+        return None

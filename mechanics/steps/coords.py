@@ -19,8 +19,10 @@ def generalized_coordinates(model: Model, work: Work) -> Step:
     text = (
         f"{len(model.bodies)} bod{'y' if len(model.bodies) == 1 else 'ies'}: {count} coordinates "
         f"without constraints; the positions below use n = {n} generalized coordinate"
-        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs k = {k} holonomic constraints "
-        "(eq. 12). Each position r_i(q, t) satisfies them for every value of q."
+        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs k = {k} holonomic constraint"
+        f"{'s' if k != 1 else ''} "
+        f"(eq. 12). Each position r_i(q, t) satisfies {'it' if k == 1 else 'them'} for every "
+        "value of q."
     )
     moving = [
         name

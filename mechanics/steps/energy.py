@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from mechanics.expr import to_plain
-from mechanics.model import Model
+from mechanics.model import Model, reference_value
 from mechanics.steps import Line, Step, Work, eq_line, sub, tidy
 
 
@@ -48,11 +48,18 @@ def energies(model: Model, work: Work) -> Step:
         "spring (eq. 27) and any given potential."
     )
     for s in model.springs:
-        if s.branch is not None:
-            text += (
-                f" The spring {s.name} lies along a line, so ℓ = |{to_plain(s.branch)}|; it is "
-                f"written ℓ = {to_plain(s.branch)}, the side of its anchor where that is > 0 (the "
-                "initial state's). A run that starts on the other side is derived with the "
-                "opposite sign, and one that reaches ℓ = 0 stops there."
+        if s.branch is None:
+            continue
+        p = to_plain(s.branch)
+        text += (
+            f" The spring {s.name} lies along a line, so ℓ = |{p}|; it is written ℓ = {p}, "
+            f"taking {p} > 0 (the side of its anchor the spec's initial state is on, or this side "
+            "when that state is at the anchor). A run that starts on the other side is derived "
+            "with the opposite sign, and one that reaches ℓ = 0 stops there."
+        )
+        if reference_value(s.branch, model.spec, model.names) == 0:
+            work.warnings.append(
+                f"The spec's initial state puts the spring {s.name} at its anchor (ℓ = 0), where "
+                "it has no direction: give `initial` a state off the anchor to simulate it."
             )
     return Step("energy", "Kinetic and potential energy", text, lines)

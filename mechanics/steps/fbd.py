@@ -379,6 +379,12 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
                 )
         elif alone and body.kind == "particle" and not forces[name]:
             note = f"{name}: no constraint acts on it (it moves freely with ${coords}$)"
+            if free == 2 and body.position.dot(model.N.z) == 0:
+                note = (
+                    f"{name}: it moves freely in the plane of the motion with ${coords}$; the "
+                    "plane itself (z = 0) is its one constraint, and no force pushes across it, "
+                    "so that constraint's force is zero"
+                )
         else:
             why = []
             if coupled:

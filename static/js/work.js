@@ -30,7 +30,9 @@ export function showWork(run, { lecture = false } = {}) {
   if (!run || !run.work) return;
   const t = run.t, end = t[t.length - 1];
   const t1box = $("work-t1"), t2box = $("work-t2");
-  if (t2box.value === "" || Number(t2box.value) > end) t2box.value = end.toFixed(2);
+  // rounded up, so a run that ends between two hundredths (at a stop) is taken to its end
+  const last = (Math.ceil(end * 100 - 1e-9) / 100).toFixed(2);
+  if (t2box.value === "" || Number(t2box.value) > Number(last)) t2box.value = last;
   const i = index(t, Math.max(0, Number(t1box.value) || 0));
   const j = index(t, Math.min(end, Number(t2box.value)));
   const rows = [];
