@@ -93,6 +93,10 @@ function yourTurn(stepId, target, coordinates) {
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
         await typeset([box]);
       } catch (err) {
+        // an answer that could not be read replaces the previous answer's result, never sits
+        // beside it (a stale "✔ Correct" under a new parse error)
+        for (const part of [".echo", ".expected"]) box.querySelector(part).textContent = "";
+        box.querySelector(".feedback").replaceChildren();
         verdict.textContent = err.message;
         verdict.className = "verdict bad";
       }
