@@ -155,7 +155,7 @@ def _dry_friction(d: Derivation) -> bool:
     return any(
         f.args and any(f.args[0].has(v) for v in qd)
         for Q in d.work.Q
-        for f in sp.sympify(Q).atoms(sp.sign, sp.Abs)
+        for f in (sp.S.Zero + Q).atoms(sp.sign, sp.Abs)
     )
 
 
