@@ -771,10 +771,13 @@ def _classify(M, C, K, n_free, names):
             vecs,
         )
     if k_pd_off_free and c_psd:
-        reason = (
-            "K is positive definite, so the potential (V minus the centrifugal term where a "
-            "frame turns) has a minimum; velocity-linear terms cannot undo that (Thomson–Tait)"
-        )
+        reason = "K is positive definite, so the potential has a minimum here"
+        if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
+            reason = (
+                "K is positive definite, so the potential (with the centrifugal term where a "
+                "frame turns) has a minimum; velocity-linear terms cannot undo that "
+                "(Thomson–Tait)"
+            )
         if damped:
             reason += ", and damping makes the motion decay"
         return "stable", reason + f" (eigenvalues {shown}){free_note}", lam, vecs
