@@ -15,21 +15,32 @@ one. Its size and per-client limit come from the environment:
 - ``LAGRANGE_LAB_POOL_PER_CLIENT``: jobs one client may have running at once (half the workers);
 - ``LAGRANGE_LAB_TRUST_FORWARDED``: ``1`` when behind a proxy that sets X-Forwarded-For (the
   client is then its last address, the one the proxy saw); otherwise the peer address is.
+
+A built-in scene's simulation is numeric work on trusted equations and runs in this process (a
+thread of the server), without the pool's round trip; its own budget is the integrator's wall
+time. Those runs pass a `FairGate` (`in_process`) with the pool's rule of admission: a few at once
+(so 45 heavy runs do not share the cores 45 ways and all run out of time, nor hold every thread
+of the server), one client's runs beyond its limit waiting behind its own.
 """
 
 from __future__ import annotations
 
+import asyncio
 import json
 import logging
 import os
 import threading
-from collections.abc import AsyncIterator
+from collections import Counter
+from collections.abc import AsyncIterator, Callable
 from contextlib import asynccontextmanager
+from dataclasses import dataclass, field
 from typing import Any
 
 from fastapi import HTTPException, Request
+from starlette.concurrency import run_in_threadpool
 
 from app.schemas import DeriveResponse
+from mechanics.budget import BudgetExceeded
 from mechanics.pool import WorkerLost, WorkerPool
 from mechanics.scenes import scene_ids
 from mechanics.spec import SceneSpec, parse_spec
@@ -220,3 +231,117 @@ def on_scene(
 #: computes them: a class of 200 asks for the same equilibria and types the same answers.
 #: Refusals and budget errors are raised, never stored.
 RESULT_STORES = {"equilibria_json": "equilibria", "newton": "newton", "answer_check": "check"}
+
+
+#: In-process runs (built-in scenes' simulations) at once per server process: twice the cores, so
+#: a few clients' long runs leave room for everyone's short ones while the cores are not shared
+#: so many ways that every run runs out of its wall time.
+IN_PROCESS_RUNS = 2 * max(1, os.cpu_count() or 1)
+#: In-process runs one client may have at once; its further runs wait behind its own.
+IN_PROCESS_PER_CLIENT = 1
+#: How long an in-process run may wait for its turn; its own wall time starts when it starts.
+IN_PROCESS_START_SECONDS = 10.0
+
+
+@dataclass(eq=False)
+class _Ticket:
+    client: str
+    loop: asyncio.AbstractEventLoop
+    turn: asyncio.Future = field(repr=False)
+    granted: bool = False
+
+
+class FairGate:
+    """At most ``total`` runs at once and ``per_client`` of one client's; waiting runs start in
+    arrival order, skipping the clients at their limit (the rule of mechanics/pool.py, for work
+    in this process's threads). Waiting holds no thread: a flood of waiting requests leaves the
+    threadpool to ``/healthz``, pages and everyone else.
+
+    Thread-safe and not bound to one event loop (each waiter is woken on its own loop).
+    """
+
+    def __init__(self, total: int, per_client: int) -> None:
+        self.total = max(1, total)
+        self.per_client = max(1, per_client)
+        self._lock = threading.Lock()
+        self._running: Counter[str] = Counter()
+        self._waiting: list[_Ticket] = []
+
+    @asynccontextmanager
+    async def turn(self, client: str, seconds: float, what: str) -> AsyncIterator[None]:
+        """Hold one of the places while the block runs; raise BudgetExceeded("time") (a 503) if
+        none is granted within ``seconds``."""
+        await self._enter(client, seconds, what)
+        try:
+            yield
+        finally:
+            self._leave(client)
+
+    def running(self) -> int:
+        with self._lock:
+            return sum(self._running.values())
+
+    async def _enter(self, client: str, seconds: float, what: str) -> None:
+        loop = asyncio.get_running_loop()
+        ticket = _Ticket(client, loop, loop.create_future())
+        with self._lock:
+            self._waiting.append(ticket)
+            self._grant()
+        try:
+            await asyncio.wait_for(ticket.turn, seconds)
+        except (TimeoutError, asyncio.CancelledError) as stopped:
+            with self._lock:
+                if not ticket.granted:
+                    self._waiting.remove(ticket)
+                    if isinstance(stopped, TimeoutError):
+                        raise BudgetExceeded("time", self._busy(client, seconds, what)) from None
+                    raise
+            if isinstance(stopped, asyncio.CancelledError):  # granted as it was cancelled
+                self._leave(client)
+                raise
+
+    def _leave(self, client: str) -> None:
+        with self._lock:
+            self._running[client] -= 1
+            if self._running[client] <= 0:
+                del self._running[client]
+            self._grant()
+
+    def _grant(self) -> None:
+        """Give free places to waiting tickets in arrival order (under the lock)."""
+        for ticket in list(self._waiting):
+            if sum(self._running.values()) >= self.total:
+                return
+            if self._running[ticket.client] >= self.per_client:
+                continue
+            self._waiting.remove(ticket)
+            try:
+                ticket.loop.call_soon_threadsafe(_wake, ticket.turn)
+            except RuntimeError:  # its event loop is gone: nobody is waiting on it
+                continue
+            ticket.granted = True
+            self._running[ticket.client] += 1
+
+    def _busy(self, client: str, seconds: float, what: str) -> str:
+        mine = self._running[client]
+        if mine >= self.per_client:
+            return (
+                f"you already have {mine} {what}{'s' if mine > 1 else ''} running and this one "
+                f"could not start within {seconds:g} s; wait for the answers, then try again"
+            )
+        return f"the server is busy: no {what} could start within {seconds:g} s; try again shortly"
+
+
+def _wake(turn: asyncio.Future) -> None:
+    if not turn.done():
+        turn.set_result(None)
+
+
+in_process_gate = FairGate(IN_PROCESS_RUNS, IN_PROCESS_PER_CLIENT)
+
+
+async def in_process(http: Request, fn: Callable[..., Any], *args: Any, what: str) -> Any:
+    """``fn(*args)`` in a thread of this process once the gate lets it start (a 503 if it cannot
+    within ``IN_PROCESS_START_SECONDS``); its own budget starts then, not while it waited."""
+    async with in_process_gate.turn(client_of(http), IN_PROCESS_START_SECONDS, what):
+        return await run_in_threadpool(fn, *args)

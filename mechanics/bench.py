@@ -253,7 +253,29 @@ def main(argv: list[str] | None = None) -> int:
     i = sub.add_parser("integrate", help="work-precision table of the integrators vs a baseline")
     i.add_argument("scenes", nargs="*", help="scene ids of the problems to run (default: all)")
     i.add_argument("--html", default="work-precision.html", help="where to write the diagram")
+    load = sub.add_parser(
+        "load", help="a crowd of simulated students against a real server on loopback"
+    )
+    load.add_argument("--students", type=int, default=50, help="crowd size (default 50)")
+    load.add_argument("--think", type=float, default=2.0, help="mean think time, s (default 2)")
+    load.add_argument("--duration", type=float, default=20.0, help="seconds per run (default 20)")
+    load.add_argument(
+        "--workers", type=int, nargs="+", default=[1, 2], help="server workers to try (1 2)"
+    )
+    load.add_argument(
+        "--hostile", type=int, nargs="+", default=[0, 10], help="hostile requests per run (0 10)"
+    )
     args = parser.parse_args(argv)
+    if args.what == "load":
+        from mechanics.bench_load import main as load_main
+
+        if not 1 <= args.students <= 1000 or not 0 < args.duration <= 600:
+            parser.error("--students must be 1..1000 and --duration 0..600 s")
+        if args.think < 0 or any(w < 1 or w > 8 for w in args.workers):
+            parser.error("--think must be ≥ 0 and --workers 1..8")
+        if any(h < 0 or h > 100 for h in args.hostile):
+            parser.error("--hostile must be 0..100")
+        return load_main(args.students, args.think, args.duration, args.workers, args.hostile)
     if args.what == "derive":
         scenes = [s for s in args.scenes if s not in SYSTEMS] if args.scenes else scene_ids()
         systems = [s for s in args.scenes if s in SYSTEMS] if args.scenes else list(SYSTEMS)

@@ -303,7 +303,13 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
     elif run.status != "ok":
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
-        if "step" in run.message.lower() or "budget" in run.message.lower():
+        if "wall-time" in run.message:  # out of time says nothing about stiffness
+            warnings.append(
+                f"The run took longer than its {MAX_WALL_TIME:g} s of wall time (the server may "
+                "have been busy): try again, or ask for less (a shorter t_end, a looser rtol, "
+                "dop853_c)."
+            )
+        elif "step" in run.message.lower() or "budget" in run.message.lower():
             if not METHODS[req.method].implicit:
                 warnings.append("This looks stiff for an explicit method: try Radau or BDF.")
     t, y = run.t, run.y

@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from functools import partial
 
 from fastapi import APIRouter, Request, Response
+from starlette.concurrency import run_in_threadpool
 
-from app.derivations import in_pool, posted_key
+from app.derivations import in_pool, in_process, posted_key
 from app.responses import ORJSONResponse
 from app.routes.scenes import unknown_scene
 from app.schemas import Message, MethodOut, SimulateRequest, SimulateResponse, ValidationErrors
@@ -21,13 +23,21 @@ router = APIRouter(prefix="/api/v1", tags=["simulate"])
     responses={
         404: {"model": Message, "description": "Unknown scene_id."},
         422: {"model": ValidationErrors, "description": "A field is invalid or out of bounds."},
-        503: {"model": Message, "description": "A posted scene ran past its time budget."},
+        503: {
+            "model": Message,
+            "description": "A posted scene ran past its time budget, or the run could not start "
+            "in time (the server is busy, or this client already has a run going).",
+        },
     },
     summary="Simulate a scene",
 )
-def post_simulate(request: SimulateRequest, http: Request) -> Response:
+async def post_simulate(request: SimulateRequest, http: Request) -> Response:
     """Integrate, then report the trajectory with its cost (steps, RHS evaluations, wall time)
     and accuracy (energy error or energy balance, momentum drift), and warnings in plain words.
+
+    A built-in scene runs in this process once the fair gate lets it start (app/derivations.py:
+    a few runs at once, one per client, the others waiting without holding a thread); a posted
+    one runs in the pool.
     """
     from mechanics.simulate import SimulationRequest, simulate
 
@@ -37,12 +47,19 @@ def post_simulate(request: SimulateRequest, http: Request) -> Response:
     if request.scene_id is not None:
         if request.scene_id not in scene_ids():
             raise unknown_scene(request.scene_id)
-        result = simulate(scene_id=request.scene_id, request=options)
-    else:
-        from mechanics.jobs import simulation
+        run = partial(simulate, request.scene_id, None, options)
+        return await in_process(http, lambda: _answer(run()), what="simulation")
+    from mechanics.jobs import simulation
 
-        key = posted_key(request.scene)
-        result = in_pool(http, simulation, key, options, affinity=key, what="simulating this scene")
+    key = await run_in_threadpool(posted_key, request.scene)
+    run = partial(
+        in_pool, http, simulation, key, options, affinity=key, what="simulating this scene"
+    )
+    return await run_in_threadpool(lambda: _answer(run()))
+
+
+def _answer(result: dict) -> Response:
+    """The JSON answer, encoded where the run ran (a thread), not in the event loop."""
     return ORJSONResponse(result)  # NaN/inf become null, as _finite did
 
 
