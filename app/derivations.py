@@ -49,6 +49,8 @@ log = logging.getLogger(__name__)
 
 DERIVE_SECONDS_ENV = "LAGRANGE_LAB_DERIVE_SECONDS"
 DEFAULT_DERIVE_SECONDS = 20.0
+CHECK_SECONDS_ENV = "LAGRANGE_LAB_CHECK_SECONDS"
+DEFAULT_CHECK_SECONDS = 5.0
 POOL_WORKERS_ENV = "LAGRANGE_LAB_POOL_WORKERS"
 POOL_PER_CLIENT_ENV = "LAGRANGE_LAB_POOL_PER_CLIENT"
 TRUST_FORWARDED_ENV = "LAGRANGE_LAB_TRUST_FORWARDED"
@@ -75,6 +77,16 @@ def derive_seconds() -> float:
         log.warning("%s=%r is not a positive number of seconds; using 20", DERIVE_SECONDS_ENV, raw)
         return DEFAULT_DERIVE_SECONDS
     return seconds
+
+
+def check_seconds() -> float:
+    """The wall-time budget of checking an answer on a built-in scene:
+    ``$LAGRANGE_LAB_CHECK_SECONDS`` or 5 s (an honest answer takes milliseconds)."""
+    try:
+        seconds = float(os.environ.get(CHECK_SECONDS_ENV, DEFAULT_CHECK_SECONDS))
+    except ValueError:
+        seconds = -1.0
+    return seconds if 0 < seconds < float("inf") else DEFAULT_CHECK_SECONDS
 
 
 def _positive_int(name: str, default: int) -> int:
@@ -134,6 +146,8 @@ def in_pool(
     affinity: str | None,
     what: str,
     advice: str = SIMPLIFY_SCENE,
+    seconds: float | None = None,
+    field: str = "scene",
 ) -> Any:
     """``job(*args)`` in a pool worker under the budget; a lost worker is a 503, not a 500.
 
@@ -145,12 +159,15 @@ def in_pool(
         return pool.run(
             job,
             *args,
-            seconds=derive_seconds(),
+            seconds=seconds or derive_seconds(),
             client=client_of(http),
             affinity=affinity,
             what=what,
             advice=advice,
         )
+    except BudgetExceeded as exc:
+        exc.field = field  # a check past its budget is about the answer, not the scene
+        raise
     except WorkerLost as lost:  # in the one error shape (app/errors.py), like a time budget's
         detail = [{"field": "scene", "message": f"{lost}; try again"}]
         raise HTTPException(status_code=503, detail=detail) from None
@@ -213,9 +230,24 @@ def on_scene(
     else:
         scene_id, key = None, posted_key(request.scene)
     affinity = scene_id or key
+    # judging an answer against a built-in scene's cached derivation takes milliseconds: a
+    # shorter budget keeps a hostile answer from holding a worker for the derivation's 20 s
+    checking = getattr(job, "__name__", "") == "answer_check"
+    seconds = min(check_seconds(), derive_seconds()) if checking and scene_id else None
 
     def compute() -> Any:
-        return in_pool(http, job, scene_id, key, *args, affinity=affinity, what=what, advice=advice)
+        return in_pool(
+            http,
+            job,
+            scene_id,
+            key,
+            *args,
+            affinity=affinity,
+            what=what,
+            advice=advice,
+            seconds=seconds,
+            field="answer" if checking else "scene",
+        )
 
     store = RESULT_STORES.get(getattr(job, "__name__", ""))
     if store is None:

@@ -115,9 +115,10 @@ async def expr_error(request: Request, exc: ExprError) -> JSONResponse:
 async def budget_exceeded(request: Request, exc: BudgetExceeded) -> JSONResponse:
     """Time is the server's limit (503: try later, or simplify); size is the scene's (422)."""
     message = f"{exc.kind} budget exceeded: {exc.message}"
+    field = getattr(exc, "field", "scene")
     if exc.kind == "time":
-        return JSONResponse(error_body("scene", message), status_code=503)
-    return unprocessable([{"field": "scene", "message": message}])
+        return JSONResponse(error_body(field, message), status_code=503)
+    return unprocessable([{"field": field, "message": message}])
 
 
 async def request_invalid(request: Request, exc: RequestValidationError) -> JSONResponse:

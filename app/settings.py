@@ -29,6 +29,8 @@ class Settings:
     cache: Path = Path.home() / ".cache" / "lagrange-lab"
     #: Wall-time budget in seconds of one posted scene's derivation (past it: 503).
     derive_seconds: float = 20.0
+    #: Wall-time budget in seconds of checking an answer on a built-in scene (past it: 503).
+    check_seconds: float = 5.0
     #: The C compiler for ``dop853_c`` (read by mechanics/native); "none" switches it off,
     #: empty means the first of cc, gcc, clang found.
     cc: str = ""

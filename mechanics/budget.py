@@ -26,16 +26,17 @@ DEFAULT_MEMORY_BYTES = 2 * 1024**3
 class BudgetExceeded(RuntimeError):
     """Work refused for costing too much: ``kind`` says which budget ("time" or "size")."""
 
-    def __init__(self, kind: Literal["time", "size"], message: str) -> None:
+    def __init__(self, kind: Literal["time", "size"], message: str, field: str = "scene") -> None:
         self.kind = kind
         self.message = message
+        self.field = field  # what the client should change: the scene, or a check's answer
         super().__init__(kind, message)
 
     def __str__(self) -> str:
         return self.message
 
     def __reduce__(self) -> tuple[Any, ...]:
-        return (type(self), (self.kind, self.message))
+        return (type(self), (self.kind, self.message, self.field))
 
 
 def limit_memory(extra_bytes: int) -> None:

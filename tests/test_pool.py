@@ -301,3 +301,21 @@ def test_a_stopped_server_leaves_nothing_behind(tmp_path):
     server.wait(timeout=30)  # uvicorn re-raises the SIGTERM after its graceful shutdown
     assert "Application shutdown complete" in log.read_text()
     assert wait_gone(pids, 10) == set()
+
+
+def test_a_check_on_a_built_in_scene_has_its_own_short_budget_and_names_the_answer(
+    client, monkeypatch
+):
+    """An honest answer is judged in milliseconds against the cached derivation: a hostile one
+    is refused after the check's budget (here 1 s), not the derivation's (3 s), naming `answer`."""
+    monkeypatch.setenv("LAGRANGE_LAB_CHECK_SECONDS", "1")
+    honest = {"scene_id": "simple_pendulum", "quantity": "T", "answer": "1/2 m l^2 theta'^2"}
+    assert client.post("/api/v1/check", json=honest).status_code == 200
+    hostile = {**honest, "answer": "exp(exp(exp(exp(exp(exp(theta_dot))))))"}
+    start = time.monotonic()
+    response = client.post("/api/v1/check", json=hostile)
+    elapsed = time.monotonic() - start
+    assert response.status_code == 503  # it ran for minutes when checks had no budget
+    (problem,) = response.json()["detail"]
+    assert problem["field"] == "answer" and "time budget" in problem["message"]
+    assert elapsed < 2.9  # the check's budget, not the derivation's 3 s
