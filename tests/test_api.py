@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import copy
 import os
-import socket
 import statistics
 import subprocess
 import sys
@@ -13,6 +12,7 @@ import time
 import httpx
 import pytest
 from fastapi.testclient import TestClient
+from servers import free_port
 
 # The app's error handlers need the engine's ExprError; skip (not error) until expr.py has landed.
 from app.main import app  # noqa: E402
@@ -233,12 +233,6 @@ def test_still_healthy_after_all_of_the_above(client):
     response = client.get("/healthz")
     assert response.status_code == 200
     assert response.json()["status"] == "ok"
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def children_of(pid: int) -> list[str]:

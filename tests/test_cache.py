@@ -12,7 +12,6 @@ import logging
 import math
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import threading
@@ -22,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from servers import free_port
 
 from mechanics import cache, derive, native
 from mechanics.scenes import load_scene
@@ -348,12 +348,6 @@ def test_the_disk_store_stays_bounded(monkeypatch):
     assert 0 < total <= 0.01 * 1024 * 1024 + 1200
     forget_memory()
     assert cache.get("check", {"i": 39}) == {"feedback": "x" * 1000, "i": 39}  # newest kept
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def test_without_redis_values_are_computed_and_kept_on_disk_logged_once(monkeypatch, caplog):

@@ -13,13 +13,13 @@ import socket
 import subprocess
 import sys
 import time
-import urllib.request
 from pathlib import Path
 
 import numpy as np
 import orjson
 import pytest
 from fastapi.testclient import TestClient
+from servers import free_port, serving
 
 from app.assets import IMMUTABLE, content_version
 from app.main import LagrangeLab, app, internal_error
@@ -239,35 +239,14 @@ def test_a_declared_body_over_the_limit_is_refused_unread(client):
 # -- a real server ---------------------------------------------------------------------------
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def served(tmp_path_factory):
     """``lagrange-lab serve`` (its protocol and timeouts), with a 1 s header deadline."""
-    port = _free_port()
+    port = free_port()
     env = {**os.environ, "LAGRANGE_LAB_CACHE": str(tmp_path_factory.mktemp("cache"))}
     command = [sys.executable, "-m", "app", "serve", "--port", str(port), "--timeout-headers", "1"]
-    proc = subprocess.Popen(command, env=env, cwd=ROOT, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + 60
-    while True:
-        try:
-            urllib.request.urlopen(f"http://127.0.0.1:{port}/healthz", timeout=1)
-            break
-        except OSError:
-            if time.monotonic() > deadline or proc.poll() is not None:
-                proc.kill()
-                raise RuntimeError("the server did not start") from None
-            time.sleep(0.2)
-    yield port, proc.pid
-    proc.terminate()
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
+    with serving(command, port, env=env, cwd=ROOT, stderr=subprocess.DEVNULL) as (_, proc):
+        yield port, proc.pid
 
 
 def _rss_mib(pid: int) -> float:

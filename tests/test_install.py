@@ -10,16 +10,15 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import socket
 import subprocess
 import sys
-import time
 import urllib.request
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from urllib.parse import urlparse
 
 import pytest
+from servers import free_port, serving
 
 ROOT = Path(__file__).resolve().parent.parent
 CHROMIUM = "/usr/bin/chromium"
@@ -27,12 +26,6 @@ CHROMIUM = "/usr/bin/chromium"
 SOURCES = ["pyproject.toml", "README.md", "app", "mechanics", "templates", "static"]
 
 pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _run(*command: str | Path, cwd: Path) -> None:
@@ -82,27 +75,12 @@ def installed(tmp_path_factory) -> str:
     ).stdout.split()
     assert all(Path(w).is_relative_to(venv) for w in where), where
 
-    port = _free_port()
+    port = free_port()
     env = {**os.environ, "LAGRANGE_LAB_CACHE": str(work / "cache"), "PYTHONPATH": ""}
     command = [venv / "bin" / "lagrange-lab", "serve", "--port", str(port)]
-    proc = subprocess.Popen(command, cwd=home, env=env, stderr=subprocess.DEVNULL)
-    url = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 60
-    while True:
-        try:
-            urllib.request.urlopen(f"{url}/healthz", timeout=1)
-            break
-        except OSError:
-            if time.monotonic() > deadline or proc.poll() is not None:
-                proc.kill()
-                raise RuntimeError("the installed server did not start") from None
-            time.sleep(0.2)
-    yield url
-    proc.terminate()
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        proc.kill()
+    popen = {"cwd": home, "env": env, "stderr": subprocess.DEVNULL}
+    with serving(command, port, what="the installed server", **popen) as (url, _):
+        yield url
 
 
 def _get(url: str) -> tuple[int, bytes]:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -18,6 +17,7 @@ import time
 import httpx
 import pytest
 from fastapi.testclient import TestClient
+from servers import free_port
 
 from app import derivations
 from app.main import app
@@ -223,12 +223,6 @@ def test_shutdown_reaps_every_worker(monkeypatch):
 
 
 # --- a real server ---------------------------------------------------------------------------
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def serve(port: int, log) -> subprocess.Popen:

@@ -15,7 +15,6 @@ import json
 import logging
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import time
@@ -24,6 +23,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from servers import free_port
 
 from mechanics import cache
 
@@ -38,12 +38,6 @@ if REDIS_SERVER is None and not IN_CI:  # CI installs it (.ci/run) and fails wit
     )
 
 redis = pytest.importorskip("redis") if not IN_CI else __import__("redis")
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def start_redis(folder: Path) -> tuple[subprocess.Popen, str]:
