@@ -98,6 +98,7 @@ class Trajectory:
     njev: int  # Jacobian evaluations (0 when the method has none)
     wall_time: float  # seconds
     note: str = ""  # how the method ran, when not as named (e.g. no C compiler: scipy's DOP853)
+    t_reached: float = math.nan  # how far the stepping got (past the last sample when stopped)
 
     def __post_init__(self) -> None:
         # Counters reach the JSON of a response: plain Python numbers, whatever counted them
@@ -264,6 +265,7 @@ def integrate(
         run.njev,
         time.perf_counter() - start,
         note,
+        f.t if status != "ok" else float(t_eval[-1]),
     )
 
 
@@ -308,6 +310,7 @@ def _compiled(rhs, y0, t_eval, rtol, atol, max_steps, budget, start) -> Trajecto
         r.nsteps,
         0,
         time.perf_counter() - start,
+        t_reached=r.t_reached,
     )
 
 

@@ -303,11 +303,17 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
     elif run.status != "ok":
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
-        if "wall-time" in run.message:  # out of time says nothing about stiffness
+        if "wall-time" in run.message:  # out of time: stiffness, or a busy server
+            stiff = not METHODS[req.method].implicit and _looks_stiff(c, params, run)
             warnings.append(
-                f"The run took longer than its {MAX_WALL_TIME:g} s of wall time (the server may "
-                "have been busy): try again, or ask for less (a shorter t_end, a looser rtol, "
-                "dop853_c)."
+                f"The run took longer than its {MAX_WALL_TIME:g} s of wall time"
+                + (
+                    ": its steps were held down by the fastest mode (a stiff system), where an "
+                    "explicit method needs tiny steps: try Radau or BDF."
+                    if stiff
+                    else " (the server may have been busy): try again, or ask for less (a "
+                    "shorter t_end, a looser rtol, dop853_c)."
+                )
             )
         elif "step" in run.message.lower() or "budget" in run.message.lower():
             if not METHODS[req.method].implicit:
@@ -772,6 +778,32 @@ def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, lis
                     "pushes there, but a string would go slack and the motion would change."
                 )
     return out
+
+
+def _looks_stiff(c: CompiledScene, params: list[float], run: Any) -> bool:
+    """Were the explicit steps limited by stability rather than accuracy? Then h·ρ(J), the mean
+    step times the fastest rate of the linearized motion where the run ended, is of order 1 (an
+    explicit Runge–Kutta method is stable only for |hλ| ≲ 3); for steps held down by accuracy it
+    is far smaller."""
+    n = c.n
+    reached = run.t_reached if math.isfinite(run.t_reached) else run.t[-1]
+    if run.nsteps < 1 or not reached > run.t[0]:
+        return False
+    f, y = c.rhs(params), np.array(run.y[-1], dtype=float)
+    try:
+        with np.errstate(all="ignore"):
+            base = np.asarray(f(run.t[-1], y), dtype=float)[: 2 * n]
+            jac = np.empty((2 * n, 2 * n))
+            for j in range(2 * n):
+                e = 1.4901161193847656e-08 * max(1.0, abs(y[j]))
+                probe = y.copy()
+                probe[j] += e
+                jac[:, j] = (np.asarray(f(run.t[-1], probe), dtype=float)[: 2 * n] - base) / e
+            rho = float(np.max(np.abs(np.linalg.eigvals(jac))))
+    except (*_PHYSICAL, ValueError):
+        return False
+    h = (reached - run.t[0]) / run.nsteps
+    return math.isfinite(rho) and h * rho > 0.5
 
 
 def _singularity_warnings(c, t, q, qd, params) -> list[str]:

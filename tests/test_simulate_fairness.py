@@ -31,6 +31,13 @@ WALL_SECONDS = 1.5  # each heavy run's wall time, shortened from 10 s for the te
 START_SECONDS = 3.0  # how long a run may wait for its turn, shortened from 10 s
 
 
+def run_in_thread(scenario) -> None:
+    """asyncio.run in a thread of its own: the browser tests' Playwright keeps an event loop
+    running in the main thread for the whole session."""
+    with ThreadPoolExecutor(1) as pool:
+        pool.submit(asyncio.run, scenario()).result()
+
+
 def test_gate_lets_another_client_pass_a_client_at_its_limit():
     async def scenario():
         gate = FairGate(total=2, per_client=1)
@@ -57,7 +64,7 @@ def test_gate_lets_another_client_pass_a_client_at_its_limit():
         await asyncio.gather(first, honest)
         assert gate.running() == 0
 
-    asyncio.run(scenario())
+    run_in_thread(scenario)
 
 
 def test_gate_busy_refusal_and_arrival_order():
@@ -81,7 +88,7 @@ def test_gate_busy_refusal_and_arrival_order():
         await asyncio.gather(holder, *waiters)
         assert order == ["a", "c", "d"]
 
-    asyncio.run(scenario())
+    run_in_thread(scenario)
 
 
 @pytest.fixture
