@@ -41,7 +41,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.schemas import DeriveResponse
 from mechanics.budget import BudgetExceeded
-from mechanics.pool import WorkerLost, WorkerPool
+from mechanics.pool import WorkerLost, WorkerPool, busy_message
 from mechanics.scenes import scene_ids
 from mechanics.spec import SceneSpec, parse_spec
 
@@ -355,13 +355,9 @@ class FairGate:
             self._running[ticket.client] += 1
 
     def _busy(self, client: str, seconds: float, what: str) -> str:
-        mine = self._running[client]
-        if mine >= self.per_client:
-            return (
-                f"you already have {mine} {what}{'s' if mine > 1 else ''} running and this one "
-                f"could not start within {seconds:g} s; wait for the answers, then try again"
-            )
-        return f"the server is busy: no {what} could start within {seconds:g} s; try again shortly"
+        return busy_message(
+            self._running[client], self.per_client, seconds, what, f"no {what} could start"
+        )
 
 
 def _wake(turn: asyncio.Future) -> None:

@@ -258,13 +258,9 @@ class WorkerPool:
         return self._free[0]
 
     def _busy_message(self, client: str, seconds: float) -> str:
-        mine = self._running[client]
-        if mine >= self.per_client:
-            return (
-                f"you already have {mine} request{'s' if mine > 1 else ''} running and this one "
-                f"could not start within {seconds:g} s; wait for the answers, then try again"
-            )
-        return f"the server is busy: no worker was free within {seconds:g} s; try again shortly"
+        return busy_message(
+            self._running[client], self.per_client, seconds, "request", "no worker was free"
+        )
 
     def _release(self, slot: _Slot, client: str) -> None:
         if slot.broken and not self._closed:
@@ -386,3 +382,14 @@ def _exit_with_server(lifeline: Connection) -> None:
             ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, signal.SIGKILL)
         except (OSError, AttributeError):
             pass
+
+
+def busy_message(mine: int, per_client: int, seconds: float, what: str, busy: str) -> str:
+    """Why a job could not start in time, in words that tell the client what to do: its own
+    queue (wait for its answers) or the server's (try again shortly)."""
+    if mine >= per_client:
+        return (
+            f"you already have {mine} {what}{'s' if mine > 1 else ''} running and this one "
+            f"could not start within {seconds:g} s; wait for the answers, then try again"
+        )
+    return f"the server is busy: {busy} within {seconds:g} s; try again shortly"
