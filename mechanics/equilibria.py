@@ -21,6 +21,7 @@ verdict are one procedure whose parts only make sense together.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import time
@@ -264,6 +265,22 @@ def _checked(d: Derivation, parameters: dict[str, float]) -> dict[str, float]:
 
 
 def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
+    """The step is the same for every parameter value (a slider move asks again): its lines are
+    built once per derivation, a fresh Step each time (callers append to its lines)."""
+    known = d.__dict__.setdefault("_virtual_work_lines", {})
+    key = tuple(conditions)
+    if key not in known:
+        known[key] = _virtual_work_lines(d, conditions)
+    text = (
+        "Constraint forces do no virtual work, so only the applied forces enter: "
+        "δW = Σ_j Q_j δq_j with Q_j = Q_j^NC − ∂V/∂q_j evaluated at rest (q̇ = 0; where a "
+        "frame turns at a prescribed rate, the equations of motion at q̇ = q̈ = 0). The δq_j "
+        "are arbitrary, so each Q_j must vanish (notes II.A, eq. 18)."
+    )
+    return Step("virtual_work", "Equilibrium by virtual work", text, list(known[key]))
+
+
+def _virtual_work_lines(d: Derivation, conditions: list[sp.Expr]) -> list[Line]:
     m = d.model
     lines = []
     for b in m.bodies:
@@ -280,14 +297,7 @@ def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
                     f"delta r_{b.name}",
                 )
             )
-    lines += _condition_lines(d, conditions)
-    text = (
-        "Constraint forces do no virtual work, so only the applied forces enter: "
-        "δW = Σ_j Q_j δq_j with Q_j = Q_j^NC − ∂V/∂q_j evaluated at rest (q̇ = 0; where a "
-        "frame turns at a prescribed rate, the equations of motion at q̇ = q̈ = 0). The δq_j "
-        "are arbitrary, so each Q_j must vanish (notes II.A, eq. 18)."
-    )
-    return Step("virtual_work", "Equilibrium by virtual work", text, lines)
+    return lines + _condition_lines(d, conditions)
 
 
 def _condition_lines(d: Derivation, conditions: list[sp.Expr], where: str = "") -> list[Line]:
@@ -682,6 +692,13 @@ def _starts(system: _System) -> np.ndarray:
 # --- stability from the full linearization ---------------------------------------------------
 
 
+@functools.lru_cache(maxsize=4096)
+def _derivative(expr: sp.Expr, var: sp.Expr) -> sp.Expr:
+    """∂f/∂q of the forcing, once per scene: every equilibrium and every parameter value needs
+    the same symbolic derivative, evaluated at different numbers."""
+    return expr.diff(var)
+
+
 def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Verdict:
     """M δq̈ + C δq̇ + K δq = 0 with K = −∂f/∂q, C = −∂f/∂q̇ at rest; the eigenvalues λ of the
     first-order system decide (δq ∝ e^{λt}), and why is put in words.
@@ -703,8 +720,8 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
     if not idx:
         return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
     f = [v.forcing[j] for j in idx]
-    K = np.array([[-num(fj.diff(m.q[k])) for k in idx] for fj in f])
-    C = np.array([[-num(fj.diff(m.qd[k])) for k in idx] for fj in f])
+    K = np.array([[-num(_derivative(fj, m.q[k])) for k in idx] for fj in f])
+    C = np.array([[-num(_derivative(fj, m.qd[k])) for k in idx] for fj in f])
     M = full_M[np.ix_(idx, idx)]
     if not all(np.all(np.isfinite(x)) for x in (M, C, K)):
         raise _BeyondDoubles
