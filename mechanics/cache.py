@@ -504,6 +504,8 @@ class _RedisBackend(_Backend):
 
     def __init__(self, client: Any, disk: _DiskBackend) -> None:
         self.client, self.disk = client, disk
+        # a fixed Lua script (no user text), run by its SHA: the lock is deleted only by its owner
+        self._release = client.register_script(self.RELEASE)
 
     def read(self, s: Store, key: str) -> bytes | None:
         return self._do(lambda: self.client.get(_rkey(s, key)), lambda: self.disk.read(s, key))
@@ -526,7 +528,7 @@ class _RedisBackend(_Backend):
 
     def release(self, s: Store, key: str, token: str) -> None:
         self._do(
-            lambda: self.client.eval(self.RELEASE, 1, _rkey(s, key, "lock"), token),
+            lambda: self._release(keys=[_rkey(s, key, "lock")], args=[token]),
             lambda: self.disk.release(s, key, token),
         )
 
