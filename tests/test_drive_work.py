@@ -10,26 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from independent import own_run
 
 from mechanics.scenes import load_scene
 from mechanics.simulate import SimulationRequest, simulate
 
 TIGHT = {"rtol": 1e-11, "atol": 1e-12}
-
-
-def own_run(rhs, y0, t_eval):
-    sol = solve_ivp(
-        rhs,
-        (0.0, float(t_eval[-1])),
-        y0,
-        method="DOP853",
-        t_eval=t_eval,
-        rtol=1e-12,
-        atol=1e-13,
-    )
-    assert sol.success, sol.message
-    return sol
 
 
 def assert_balance(result, rel=1e-7):

@@ -12,6 +12,7 @@ import copy
 import numpy as np
 import pytest
 import sympy as sp
+from independent import own_run
 from scipy.integrate import solve_ivp
 
 from mechanics.derive import derive_model
@@ -41,21 +42,6 @@ def block_on_spring(initial: dict[str, float] | None = None) -> dict:
 def line_spring_rhs(t: float, y: np.ndarray) -> list[float]:
     x, v = y
     return [v, -K / M * (abs(x) - L0) * np.sign(x)]
-
-
-def own_run(rhs, y0, t_eval, events=None):
-    sol = solve_ivp(
-        rhs,
-        (0.0, float(t_eval[-1])),
-        y0,
-        method="DOP853",
-        t_eval=t_eval,
-        rtol=1e-12,
-        atol=1e-13,
-        events=events,
-    )
-    assert sol.success, sol.message
-    return sol
 
 
 def plain(expr: sp.Expr, model) -> tuple[list[sp.Symbol], list[sp.Symbol], sp.Expr]:
