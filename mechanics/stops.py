@@ -22,6 +22,16 @@ from mechanics.numeric import CompiledScene, evaluate
 from mechanics.spec import SpecError
 
 
+def applies(stop: Any, t: float, y: np.ndarray, n: int, params: list[float]) -> bool:
+    """Does the stop apply in this state (its `only_if` ≥ 0)? An undefined (NaN) guard counts as
+    applying: a model whose condition cannot even be evaluated has stopped holding."""
+    if stop.only_if is None:
+        return True
+    q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
+    with np.errstate(all="ignore"):
+        return not float(np.asarray(stop.only_if(t, *q, *qd, *params)[0])) < 0
+
+
 @dataclass
 class StopEvent:
     name: str
@@ -59,14 +69,7 @@ class StopWatch:
             return [float(np.asarray(st.value(t, *q, *qd, *self.params)[0])) for st in self.c.stops]
 
     def guard(self, stop: Any, t: float, y: np.ndarray) -> bool:
-        """Does the stop apply here? An undefined (NaN) guard counts as applying: a model whose
-        condition cannot even be evaluated has stopped holding."""
-        if stop.only_if is None:
-            return True
-        n = self.c.n
-        q, qd = y[:n].tolist(), y[n : 2 * n].tolist()
-        g = float(np.asarray(stop.only_if(t, *q, *qd, *self.params)[0]))
-        return not g < 0
+        return applies(stop, t, y, self.c.n, self.params)
 
     def __call__(self, t: float, y: np.ndarray) -> bool:
         values = self._values(t, y)
@@ -349,9 +352,7 @@ def _locate(c, t0, y0, t1, params, req) -> tuple[Any, float, np.ndarray] | None:
             return None
         t_hit, i, y_hit = min(hits, key=lambda h: h[0])
         stop = c.stops[i]
-        q, qd = y_hit[:n].tolist(), y_hit[n : 2 * n].tolist()
-        guard = np.nan if stop.only_if is None else stop.only_if(t_hit, *q, *qd, *params)[0]
-        if stop.only_if is None or not float(np.asarray(guard)) < 0:
+        if applies(stop, t_hit, y_hit, n, params):
             return stop, float(t_hit), y_hit
         if t_hit >= t1:
             return None
