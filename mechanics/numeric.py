@@ -96,12 +96,10 @@ class CompiledScene:
         args, subs = _args(self.derivation)
         out = []
         for i, st in enumerate(self.stop_specs):
-            if st.tension is not None and st.along is not None:
-                force = constraint_force_functions(self).get(st.tension, (None, None))[0]
-                value = _along(force, st.along)
-            elif st.tension is not None:
-                fns = constraint_force_functions(self)
-                if fns.get(st.tension, (None, None))[1] is None:
+            if st.tension is not None:
+                force, tension = constraint_force_functions(self).get(st.tension, (None, None))
+                value = _along(force, st.along) if st.along is not None and force else tension
+                if value is None:
                     raise SpecError(
                         [
                             {
@@ -111,7 +109,6 @@ class CompiledScene:
                             }
                         ]
                     )
-                value = fns[st.tension][1]
             else:
                 value = sp.lambdify(args, [_plain(st.when, subs)], modules=_NUMPY)
             guard = None
