@@ -132,8 +132,8 @@ def _at(fn: Any, t0: float, y0: np.ndarray, n: int, params: list[float]) -> list
 
 def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any) -> None:
     """The state a run starts from must lie where the derived equations hold: every branched
-    spring on the side it was derived for and off its anchor, every declared stop not already
-    passed, and a mass matrix that can be inverted."""
+    spring on the side it was derived for and off its anchor, a mass matrix that can be
+    inverted, and numbers a double can hold (declared stops: `stops.refuse_passed_stops`)."""
     n, m = c.n, c.derivation.model
     errors = []
     names = ", ".join(f"initial.{q}" for q in c.coordinates if q in req.initial) or "initial"
