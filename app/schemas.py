@@ -349,8 +349,14 @@ class Equilibrium(BaseModel):
     symbolic: dict[str, str] = Field(
         description="Closed form per coordinate, where sympy found it."
     )
+    symbolic_latex: dict[str, str] = Field(
+        default={}, description="The same closed forms in LaTeX, for display."
+    )
     free: list[str] = Field(description="Coordinates absent from the conditions (any value).")
     exists_when: str = Field(description="Condition for existence, e.g. |g/(Omega**2*R)| <= 1.")
+    exists_when_latex: str = Field(
+        default="", description="The same condition in LaTeX; empty when it always exists."
+    )
     found_by: str = Field(
         description="closed form / closed form, confirmed numerically / numeric search."
     )

@@ -63,6 +63,8 @@ class Root:
     symbolic: dict[int, sp.Expr] = field(default_factory=dict)
     exists: str = "always"
     how: str = "closed form"
+    #: The same conditions as ``exists``, in LaTeX for the page (empty when always).
+    exists_latex: str = ""
 
 
 @dataclass
@@ -222,8 +224,10 @@ def _result_json(m: Any, root: Root, free: list[int], v: Verdict, q0: list[float
     return {
         "q": {names[j]: float(q0[j]) + 0.0 for j in range(len(m.q))},
         "symbolic": {names[j]: to_plain(root.symbolic[j]) for j in root.symbolic},
+        "symbolic_latex": {names[j]: to_latex(root.symbolic[j]) for j in root.symbolic},
         "free": [names[j] for j in free],
         "exists_when": root.exists,
+        "exists_when_latex": root.exists_latex,
         "found_by": root.how,
         "stable": v.stable,
         "kind": v.kind,
@@ -494,10 +498,12 @@ def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
     for sol in sols:
         if len(sol) < len(bound) or any(v.free_symbols & set(subs.values()) for v in sol.values()):
             return None
-        numeric, symbolic, conditions_text = {}, {}, []
+        numeric, symbolic, conditions_text, conditions_latex = {}, {}, [], []
         for j in bound:
             expr = sol[subs[m.q[j]]].xreplace(back)
-            conditions_text += _existence(expr)
+            conditions = _existence(expr)
+            conditions_text += [plain for plain, _ in conditions]
+            conditions_latex += [latex for _, latex in conditions]
             try:
                 value = complex(expr.xreplace(values).evalf())
             except (TypeError, ValueError):
@@ -508,7 +514,9 @@ def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
             numeric[j] = wrapped
             symbolic[j] = expr - 2 * sp.pi * turns if turns else expr
         else:
-            out.append(Root(numeric, symbolic, " and ".join(conditions_text) or "always"))
+            exists = " and ".join(conditions_text) or "always"
+            latex = r" \ \text{and}\  ".join(conditions_latex)
+            out.append(Root(numeric, symbolic, exists, exists_latex=latex))
     return out
 
 
@@ -516,14 +524,16 @@ def _never_zero(expr, values) -> bool:
     return not expr.free_symbols - set(values) - {t}
 
 
-def _existence(expr: sp.Expr) -> list[str]:
-    """acos(u), asin(u) need |u| ≤ 1; sqrt(u) needs u ≥ 0 — the notes' 'only when Ω² > g/R'."""
+def _existence(expr: sp.Expr) -> list[tuple[str, str]]:
+    """acos(u), asin(u) need |u| ≤ 1; sqrt(u) needs u ≥ 0 — the notes' 'only when Ω² > g/R'.
+    Each condition as (plain text, LaTeX)."""
     out = []
     for f in expr.atoms(sp.acos, sp.asin):
-        out.append(f"|{to_plain(f.args[0])}| <= 1")
+        u = f.args[0]
+        out.append((f"|{to_plain(u)}| <= 1", rf"\left|{to_latex(u)}\right| \le 1"))
     for p in expr.atoms(sp.Pow):
         if p.exp == sp.Rational(1, 2) and not p.base.is_nonnegative:
-            out.append(f"{to_plain(p.base)} >= 0")
+            out.append((f"{to_plain(p.base)} >= 0", rf"{to_latex(p.base)} \ge 0"))
     return out
 
 
