@@ -31,10 +31,16 @@ _TOKEN = re.compile(
 )
 
 
-def _normalise(text: str) -> str:
-    for k, v in {**SYMBOLS, **GREEK}.items():
-        text = text.replace(k, v if k not in GREEK else f" {v}")
-    return text
+def _normalise(text: str) -> tuple[str, list[int]]:
+    """Greek letters and math symbols as plain names and operators, and for each character of
+    the result the index of the typed character it came from (errors point at what was typed)."""
+    out: list[str] = []
+    origin: list[int] = []
+    for i, ch in enumerate(text):
+        piece = f" {GREEK[ch]}" if ch in GREEK else SYMBOLS.get(ch, ch)
+        out.append(piece)
+        origin += [i] * len(piece)
+    return "".join(out), origin
 
 
 def _velocity_name(name: str, coordinates: set[str], known: set[str]) -> str | None:
@@ -71,19 +77,32 @@ def to_convention(
     text: str, coordinates: Iterable[str], known: Iterable[str], *, field: str = "answer"
 ) -> str:
     """Rewrite a student's text into the strict convention; ExprError says where it cannot."""
+    return to_convention_mapped(text, coordinates, known, field=field)[0]
+
+
+def to_convention_mapped(
+    text: str, coordinates: Iterable[str], known: Iterable[str], *, field: str = "answer"
+) -> tuple[str, list[int]]:
+    """`to_convention`, and for each character of the result the index of the typed character
+    it came from (the end of the text for inserted ones), so the parser's positions can be
+    carried back to what the student typed."""
     if not isinstance(text, str):
         raise ExprError("expected text", field=field)
     if len(text) > MAX_LENGTH:
         raise ExprError(f"answer longer than {MAX_LENGTH} characters", field=field)
     coordinates, known = set(coordinates), set(known)
     vocabulary = known | set(FUNCTIONS) | {"pi"}
-    text = _normalise(text)
-    out: list[tuple[str, str]] = []  # (kind, text)
+    typed = text
+    text, origin = _normalise(text)
+    origin.append(len(typed))
+    out: list[tuple[str, str, int]] = []  # (kind, text, where it was typed)
     pos = 0
     while pos < len(text):
         m = _TOKEN.match(text, pos)
         if not m:
-            raise ExprError(f"character {text[pos]!r} is not allowed", field=field, position=pos)
+            raise ExprError(
+                f"character {text[pos]!r} is not allowed", field=field, position=origin[pos]
+            )
         pos = m.end()
         kind = m.lastgroup
         value = m.group(kind)
@@ -93,9 +112,11 @@ def to_convention(
             order = len(value) if kind == "prime" else (1 if value == DOT else 2)
             if not out or out[-1][0] != "name" or out[-1][1] not in coordinates:
                 raise ExprError(
-                    "a prime or dot must follow a coordinate name", field=field, position=m.start()
+                    "a prime or dot must follow a coordinate name",
+                    field=field,
+                    position=origin[m.start()],
                 )
-            out[-1] = ("name", out[-1][1] + ("_dot" if order == 1 else "_ddot"))
+            out[-1] = ("name", out[-1][1] + ("_dot" if order == 1 else "_ddot"), out[-1][2])
             continue
         if kind == "op" and value == "^":
             value = "**"
@@ -103,12 +124,21 @@ def to_convention(
             try:
                 pieces = _resolve(value, coordinates, known, vocabulary)
             except ExprError as exc:
-                raise ExprError(exc.message, field=field, position=m.start()) from None
+                raise ExprError(exc.message, field=field, position=origin[m.start()]) from None
             for piece in pieces:
-                _append(out, "name", piece)
+                _append(out, "name", piece, origin[m.start()])
             continue
-        _append(out, kind, value)
-    return " ".join(v for _, v in out)
+        _append(out, kind, value, origin[m.start()])
+    result: list[str] = []
+    where: list[int] = []
+    for k, (_, value, at) in enumerate(out):
+        if k:
+            result.append(" ")
+            where.append(at)  # the space before a token points at the token
+        result.append(value)
+        where += [at] * len(value)
+    where.append(len(typed))
+    return "".join(result), where
 
 
 def _resolve(name: str, coordinates: set[str], known: set[str], vocabulary: set[str]) -> list[str]:
@@ -123,18 +153,18 @@ def _resolve(name: str, coordinates: set[str], known: set[str], vocabulary: set[
     return [name]  # the parser reports it as unknown, naming it
 
 
-def _append(out: list[tuple[str, str]], kind: str, value: str) -> None:
+def _append(out: list[tuple[str, str, int]], kind: str, value: str, at: int) -> None:
     """Insert the '*' that juxtaposition means (`2 m`, `m l`, `l (`, `) (`), not before calls.
 
     A function written without parentheses takes the one atom after it: `cos θ` -> cos(theta).
     """
     if out and out[-1][0] == "name" and out[-1][1] in FUNCTIONS and kind in ("num", "name"):
-        out += [("op", "("), (kind, value), ("op", ")")]
+        out += [("op", "(", at), (kind, value, at), ("op", ")", at)]
         return
     if out:
-        prev_kind, prev = out[-1]
+        prev_kind, prev, _ = out[-1]
         left = prev_kind == "num" or prev == ")" or (prev_kind == "name" and prev not in FUNCTIONS)
         right = kind in ("num", "name") or value == "("
         if left and right:
-            out.append(("op", "*"))
-    out.append((kind, value))
+            out.append(("op", "*", at))
+    out.append((kind, value, at))

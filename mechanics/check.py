@@ -18,9 +18,9 @@ import sympy as sp
 from sympy.simplify.fu import TR5
 
 from mechanics import units
-from mechanics.answers import to_convention
+from mechanics.answers import to_convention_mapped
 from mechanics.derive import Derivation
-from mechanics.expr import ExprError, parse, to_latex, to_plain
+from mechanics.expr import ExprError, parse, to_latex
 from mechanics.model import T as t
 from mechanics.spec import SpecError
 from mechanics.steps import tidy
@@ -75,22 +75,73 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
             )
         j = model.coordinate_names.index(coordinate)
     expected = expected_quantity(d, quantity, j)
-    text = to_convention(answer, model.coordinate_names, model.names.keys() | {"t"})
+    given, moved = read_answer(d, quantity, answer, j)
+    verdict = Verdict(False, answer_latex=to_latex(given), expected_latex=_latex(d, quantity, j))
+    judge = _Judge(d, quantity, j, expected, given, moved)
+    judge.run(verdict)
+    return verdict
+
+
+def answer_names(d: Derivation) -> dict[str, sp.Expr]:
+    """The names an answer may use: the scene's, t, and q̈ of every coordinate."""
+    model = d.model
     names = dict(model.names)
     names.update(
         {f"{q}_ddot": qdd for q, qdd in zip(model.coordinate_names, model.qdd, strict=True)}
     )
-    if "=" in text:
-        if quantity != "eom" or text.count("=") > 1:
-            raise ExprError("'=' belongs only in an equation of motion (once)", field="answer")
-        lhs, rhs = text.split("=")
-        given = parse(lhs, names, field="answer") - parse(rhs, names, field="answer")
-    else:
-        given = parse(text, names, field="answer")
-    verdict = Verdict(False, answer_latex=to_latex(given), expected_latex=_latex(d, quantity, j))
-    judge = _Judge(d, quantity, j, expected, given)
-    judge.run(verdict)
-    return verdict
+    return names
+
+
+def read_answer(
+    d: Derivation, quantity: str, answer: str, j: int | None
+) -> tuple[sp.Expr, sp.Expr]:
+    """The answer as one expression, and the part of it typed right of '=' (zero without one).
+
+    An equation of motion may be written `lhs = rhs` (read as lhs − rhs = 0); q̈ may be written
+    `theta_ddot = ...`. Every ExprError points at the character the student typed, not at the
+    rewritten text the parser saw.
+    """
+    model = d.model
+    text, where = to_convention_mapped(answer, model.coordinate_names, model.names.keys() | {"t"})
+    names = answer_names(d)
+
+    def read(start: int, end: int) -> sp.Expr:
+        try:
+            return parse(text[start:end], names, field="answer")
+        except ExprError as exc:
+            at = None if exc.position is None else where[min(start + exc.position, len(text))]
+            raise _pointed(exc.message, answer, at) from None
+
+    if "=" not in text:
+        return read(0, len(text)), sp.S.Zero
+    equals = text.index("=")
+    if quantity not in ("eom", "accel") or text.count("=") > 1:
+        raise _pointed(
+            "'=' belongs only in an equation of motion or q̈ = ... (once)",
+            answer,
+            where[text.rindex("=") if text.count("=") > 1 else equals],
+        )
+    lhs, rhs = read(0, equals), read(equals + 1, len(text))
+    if quantity == "eom":
+        return lhs - rhs, rhs
+    qdd = model.qdd[j]
+    if lhs == qdd or rhs == qdd:
+        return (rhs if lhs == qdd else lhs), sp.S.Zero
+    name = model.coordinate_names[j]
+    raise _pointed(f"write q̈ as '{name}_ddot = ...'", answer, where[equals])
+
+
+def _pointed(message: str, typed: str, at: int | None) -> ExprError:
+    """An ExprError whose message shows where, in the text as typed: `theta + ◂here`."""
+    if at is None:
+        return ExprError(message, field="answer")
+    at = max(0, min(at, len(typed)))
+    before, after = typed[max(0, at - 24) : at], typed[at : at + 24]
+    shown = ("…" if at > 24 else "") + before + "⟨here⟩" + after
+    shown += "…" if at + 24 < len(typed) else ""
+    return ExprError(
+        f"{message} (at character {at + 1}: {shown.strip()})", field="answer", position=at
+    )
 
 
 def _latex(d: Derivation, quantity: str, j: int | None) -> str:
@@ -102,10 +153,27 @@ def _latex(d: Derivation, quantity: str, j: int | None) -> str:
     return to_latex(expected_quantity(d, quantity, j))
 
 
+def inline(expr: sp.Expr) -> str:
+    """Inline math for a feedback sentence: `$\\frac{g}{l} \\sin\\theta$` (the page renders it)."""
+    return f"${to_latex(expr)}$"
+
+
 class _Judge:
-    def __init__(self, d: Derivation, quantity: str, j: int | None, expected, given) -> None:
+    def __init__(
+        self,
+        d: Derivation,
+        quantity: str,
+        j: int | None,
+        expected: sp.Expr,
+        given: sp.Expr,
+        moved: sp.Expr = sp.S.Zero,
+    ) -> None:
         self.d, self.m, self.quantity, self.j = d, d.model, quantity, j
         self.expected, self.given = expected, given
+        self.moved = moved  # what the student wrote right of '=' (its terms changed sign)
+        # what the units of every term should be: the quantity's, or for an equation of motion
+        # the units of the student's own scaling of it (set in _eom)
+        self.reference = expected
         rng = random.Random(0)
         self.states = [self._state(rng) for _ in range(SAMPLES)]
         # The same motion states at one set of parameters: for "constant" and "multiple of",
@@ -181,7 +249,10 @@ class _Judge:
         fb = verdict.feedback
         given, expected = self.given, self.expected
         if not any(given.has(a) for a in self.m.qdd):
-            fb.append("An equation of motion must contain an acceleration (q̈); yours has none.")
+            fb.append(
+                "An equation of motion must contain an acceleration "
+                f"({inline(self.m.qdd[self.j])}); yours has none."
+            )
             self._diagnose(given, expected, fb)
             return
         if self._ratio(given, expected, motion_only=True) not in (None, 0):
@@ -194,15 +265,47 @@ class _Judge:
                 "equation (the same equation, rearranged or scaled)."
             )
             return
+        for k in range(len(self.m.q)):
+            other = expected_quantity(self.d, "eom", k)
+            if k != self.j and self._ratio(given, other, motion_only=True) not in (None, 0):
+                fb.append(
+                    f"This is the equation of motion for {inline(self.m.q[k])}, not the one for "
+                    f"{inline(self.m.q[self.j])}."
+                )
+                return
         solved = dict(zip(self.m.qdd, self.d.solved_accelerations, strict=True))
         if self.same(given.xreplace(solved), sp.S.Zero):
             fb.append(
                 "Your equation holds along the motion, but it is not the equation for "
-                f"{self.m.coordinate_names[self.j]}: it mixes in the equations of the other "
-                "coordinates."
+                f"{inline(self.m.q[self.j])}: it mixes in the equations of the other coordinates."
             )
             return
+        scale = self._scaling(given, expected)
+        if scale is not None and scale != 1:
+            # compare with the derived equation as the student scaled it, so the feedback names
+            # their own terms (g/l sin θ), not the derived equation's (m g l sin θ)
+            fb.append(
+                f"Read as the derived equation multiplied by {inline(scale)} (scaling an equation "
+                "changes nothing); against that:"
+            )
+            expected = sp.expand(expected * scale)
+        self.reference = expected
         self._diagnose(given, expected, fb)
+
+    def _scaling(self, given: sp.Expr, expected: sp.Expr) -> sp.Expr | None:
+        """The factor the student's equation carries over the derived one, read from the terms
+        both have: that of the q̈ term when it has the same form in both, else the commonest."""
+        g, e = self._canonical(given), self._canonical(expected)
+        if len(g) + len(e) > 40:
+            return None
+        ratios = {mono: sp.simplify(g[mono] / e[mono]) for mono in e if mono in g}
+        if not ratios:
+            return None
+        lead = [mono for mono in ratios if mono.has(self.m.qdd[self.j])]
+        if lead:
+            return ratios[lead[0]]
+        values = list(ratios.values())
+        return max(values, key=values.count)
 
     # -- what is wrong ---------------------------------------------------------------------
     def _diagnose(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:
@@ -210,7 +313,10 @@ class _Judge:
         if ratio == -1:
             fb.append("Sign error: your answer is the negative of the correct one.")
         elif ratio is not None and ratio != 0:
-            fb.append(f"Off by a factor of {ratio}: every term is {ratio} times what it should be.")
+            fb.append(
+                f"Off by a factor of {inline(ratio)}: every term is {inline(ratio)} times what it "
+                "should be."
+            )
         else:
             fb += self._terms(given, expected)
             fb += self._slips(given, expected)
@@ -241,9 +347,9 @@ class _Judge:
                 continue
             r = sp.simplify(g[mono] / coeff)
             if r == -1:
-                fb.append(f"The term {self._show(term)} has the wrong sign.")
+                fb.append(f"Sign error in the {self._show(term)} term{self._moved(mono)}.")
             elif r.is_number and r != 1:
-                fb.append(f"The term {self._show(term)} is off by a factor of {r}.")
+                fb.append(f"The term {self._show(term)} is off by a factor of {inline(r)}.")
             elif r != 1:
                 fb.append(
                     f"The term {self._show(term)} has the coefficient "
@@ -262,10 +368,16 @@ class _Judge:
         from_speeds = [qd for qd in self.m.qd if mono.has(qd)]
         if not from_speeds:
             return ""
-        return ": the part that comes from " + " and ".join(to_plain(v) for v in from_speeds)
+        return ": the part that comes from " + " and ".join(inline(v) for v in from_speeds)
+
+    def _moved(self, mono: sp.Expr) -> str:
+        """Why a term of an equation may have its sign flipped: it was carried across '='."""
+        if self.moved == 0 or mono not in self._canonical(self.moved):
+            return ""
+        return " (a term carried across '=' changes its sign)"
 
     def _show(self, e: sp.Expr) -> str:
-        return to_plain(tidy(e, self.m))
+        return inline(tidy(e, self.m))
 
     def _slips(self, given: sp.Expr, expected: sp.Expr) -> list[str]:
         """Typical slips: two parameters of the same units swapped, q mixed up with q̇."""
@@ -279,13 +391,16 @@ class _Judge:
                 if (given.has(a) or given.has(b)) and self.same(
                     given.xreplace({a: b, b: a}), expected
                 ):
-                    fb.append(f"{a} and {b} are swapped: a term belongs to the other body.")
-        for name, q, qd in zip(self.m.coordinate_names, self.m.q, self.m.qd, strict=True):
+                    fb.append(
+                        f"{inline(a)} and {inline(b)} are swapped: a term belongs to the "
+                        "other body."
+                    )
+        for q, qd in zip(self.m.q, self.m.qd, strict=True):
             swapped = given.xreplace({qd: q}).xreplace({q: qd}) if given.has(qd) else None
             if swapped is None:
                 swapped = given.xreplace({q: qd})
             if self.same(swapped, expected):
-                fb.append(f"You mixed up {name} and {name}_dot somewhere.")
+                fb.append(f"You mixed up {inline(q)} and {inline(qd)} somewhere.")
         return fb
 
     def _dimensions(self) -> dict[sp.Expr, units.Dim]:
@@ -311,21 +426,27 @@ class _Judge:
         dims = self._dimensions()
         if not dims:
             return []
-        want = units.dimension(sp.expand(self.expected), dims)
+        want = units.dimension(sp.expand(self.reference), dims)
         if want is None:
             return []
+        what = {
+            "T": "an energy",
+            "V": "an energy",
+            "L": "an energy",
+            "eom": f"{units.fmt(want)} like the rest of the equation",
+            "accel": f"{units.fmt(want)} (an acceleration of {inline(self.m.q[self.j or 0])})",
+        }.get(self.quantity, units.fmt(want))
         fb = []
         for term in sp.Add.make_args(sp.expand(given)):
             have = units.dimension(term, dims)
             if have is None:
                 fb.append(
-                    f"The term {to_plain(term)} mixes units (e.g. a sum inside a power or "
+                    f"The term {self._show(term)} mixes units (e.g. a sum inside a power or "
                     "a dimensional argument to a function)."
                 )
             elif have != want:
-                what = "an energy" if want == units.ENERGY else f"{units.fmt(want)}"
                 fb.append(
-                    f"The term {to_plain(term)} has units {units.fmt(have)}, not {what}: "
+                    f"The term {self._show(term)} has units {units.fmt(have)}, not {what}: "
                     "it cannot belong here."
                 )
         return fb

@@ -183,13 +183,88 @@ def _precheck(text: object, field: str) -> tuple[str, int]:
     return stripped.translate(_TO_SPACE), len(text) - len(text.lstrip())
 
 
+_GRAMMAR_TOKEN = re.compile(
+    r"(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)|(?P<name>[A-Za-z_]\w*)"
+    r"|(?P<op>\*\*|[-+*/])|(?P<open>\()|(?P<close>\))|(?P<comma>,)"
+)
+
+
+def _grammar_error(text: str) -> tuple[str, int] | None:
+    """Why and where `text` is not arithmetic, for a text Python's parser refused.
+
+    Python reports the end of the input, or column 0, for an expression that stops too early
+    (``theta +``); a walk over the tokens, alternating between "a term comes next" and "an
+    operator comes next", names the token that breaks the alternation instead. None when the
+    walk finds nothing (Python's column is used then).
+    """
+    want_term, calls, prev = True, [], None  # calls: is each open '(' a function call's?
+    pos = 0
+    while True:
+        while pos < len(text) and text[pos] == " ":
+            pos += 1
+        if pos >= len(text):
+            break
+        m = _GRAMMAR_TOKEN.match(text, pos)
+        if m is None:
+            return None
+        kind, value, start = m.lastgroup, m.group(), m.start()
+        pos = m.end()
+        if want_term:
+            if kind in ("num", "name"):
+                want_term = False
+            elif kind == "open":
+                calls.append(False)
+            elif kind == "op" and value in "+-":
+                pass  # a sign
+            elif kind == "close" and prev is not None and prev[0] == "open":
+                if not calls or not calls[-1]:
+                    return "syntax error: nothing between '(' and ')'", prev[2]
+                calls.pop()
+                want_term = False
+            elif kind == "op":
+                return f"syntax error: '{value}' needs a term before it", start
+            elif prev is None:
+                return f"syntax error: '{value}' cannot start an expression", start
+            else:
+                return f"syntax error: a term is missing after '{prev[1]}'", prev[2]
+        elif kind == "op" or (kind == "comma" and calls and calls[-1]):
+            want_term = True
+        elif kind == "close":
+            if not calls:
+                return "')' without a matching '('", start
+            calls.pop()
+        elif kind == "open" and prev is not None and prev[0] == "name":
+            calls.append(True)
+            want_term = True
+        elif kind == "open":
+            return "syntax error: write '*' before '(' to multiply", start
+        elif kind == "comma":
+            return "syntax error: a comma may only separate a function's arguments", start
+        else:
+            return (
+                f"syntax error: an operator is missing before '{value}' (write '*' to multiply)",
+                start,
+            )
+        prev = (kind, value, start)
+    if want_term and prev is not None:
+        return (
+            f"syntax error: the expression ends with '{prev[1]}', a term is missing after it",
+            prev[2],
+        )
+    return None
+
+
 def _tree(text: object, field: str) -> tuple[ast.expr, int]:
     clean, offset = _precheck(text, field)
     try:
         return ast.parse(clean, mode="eval").body, offset
     except SyntaxError as exc:
-        col = offset + max((exc.offset or 1) - 1, 0)
-        raise ExprError(f"syntax error at character {col}", field=field, position=col) from None
+        found = _grammar_error(clean)
+        if found is None:  # Python's own column, when the token walk sees nothing wrong
+            message, col = "syntax error", max((exc.offset or 1) - 1, 0)
+        else:
+            message, col = found
+        raise ExprError(message, field=field, position=offset + col) from None
     except (RecursionError, MemoryError, ValueError):
         raise ExprError("expression too complex", field=field) from None
 
@@ -408,13 +483,14 @@ def to_latex(expr: sp.Expr) -> str:
     """Textbook LaTeX: dots for time derivatives, Greek names as letters, digits as subscripts.
 
     vlatex (not sympy.latex) because it drops the (t) of coordinates and draws q' as a dot;
-    it accepts physics.vector Vectors and matrices too.
+    it accepts physics.vector Vectors and matrices too. Inverse trig functions print as the
+    notes write them (\\arccos, not \\operatorname{acos}).
     """
     if isinstance(expr, sp.Expr):
         return _latex_memo(expr)
-    return vlatex(expr)
+    return vlatex(expr, inv_trig_style="full")
 
 
 @functools.lru_cache(maxsize=4096)
 def _latex_memo(expr: sp.Expr) -> str:
-    return vlatex(expr)
+    return vlatex(expr, inv_trig_style="full")

@@ -57,11 +57,11 @@ def test_equivalent_forms_are_accepted(scene, quantity, coordinate, answer):
 @pytest.mark.parametrize(
     ("scene", "quantity", "coordinate", "answer", "says"),
     [
-        ("simple_pendulum", "T", None, "m l^2 theta_dot^2", "factor of 2"),
+        ("simple_pendulum", "T", None, "m l^2 theta_dot^2", "factor of $2$"),
         ("simple_pendulum", "V", None, "m g l cos(theta)", "Sign error"),
         ("spherical_pendulum", "T", None, "m l^2 theta_dot^2/2", "Missing term"),
-        ("spherical_pendulum", "T", None, "m l^2 theta_dot^2/2", "comes from phi_dot"),
-        ("simple_pendulum", "T", None, "m l^2 theta^2/2", "mixed up theta and theta_dot"),
+        ("spherical_pendulum", "T", None, "m l^2 theta_dot^2/2", r"comes from $\dot{\phi}$"),
+        ("simple_pendulum", "T", None, "m l^2 theta^2/2", r"mixed up $\theta$ and $\dot{\theta}$"),
         ("simple_pendulum", "T", None, "m l theta_dot^2/2", "not an energy"),
         (
             "double_pendulum",
@@ -95,13 +95,13 @@ def test_swapped_masses_are_named():
     """The bob's mass m put where the cart's M belongs, and vice versa."""
     v = verdict("cart_pendulum", "T", "(M+m)/2 x'^2 + M l cos(theta) x' theta' + M l^2 theta'^2/2")
     assert not v.correct
-    assert any("M and m are swapped" in f for f in v.feedback), v.feedback
+    assert any("$M$ and $m$ are swapped" in f for f in v.feedback), v.feedback
 
 
 def test_wrong_spring_constant_is_pointed_at():
     v = verdict("coupled_oscillators", "V", "k x1^2/2 + k12 (x2 - x1)^2/2 + k12 x2^2/2")
     assert not v.correct
-    assert any("coefficient" in f and "k12" in f for f in v.feedback), v.feedback
+    assert any("coefficient" in f and "k_{12}" in f for f in v.feedback), v.feedback
 
 
 def test_student_notation_is_rewritten_to_the_convention():
