@@ -1,13 +1,25 @@
-"""``/api/v1/scenes``: the built-in scene catalog, for menus and as starting points to edit."""
+"""``/api/v1/scenes``: the built-in scene catalog, for menus and as starting points to edit; the
+catalog's drawings in one answer; and each scene's equations as a JavaScript module for the live
+preview (mechanics/jscode.py)."""
 
 from __future__ import annotations
 
-from fastapi import APIRouter, HTTPException
+import functools
+from typing import Any
+
+from fastapi import APIRouter, HTTPException, Request, Response
+from starlette.concurrency import run_in_threadpool
 
 from app.schemas import Message, SceneDetail, SceneSummary
-from mechanics.scenes import list_scenes, load_scene
+from mechanics.scenes import list_scenes, load_scene, scene_ids
 
 router = APIRouter(prefix="/api/v1/scenes", tags=["scenes"])
+
+#: A generated module under its content hash never changes: the browser keeps it for a year.
+IMMUTABLE = "public, max-age=31536000, immutable"
+#: What may change when the server is updated (the catalog, a module's current hash):
+#: revalidated with its ETag on every visit, a 304 of a few hundred bytes when unchanged.
+REVALIDATE = "no-cache"
 
 
 def unknown_scene(scene_id: str) -> HTTPException:
@@ -19,6 +31,42 @@ def unknown_scene(scene_id: str) -> HTTPException:
 def get_scenes() -> list[dict]:
     """Every built-in scene in teaching order: id, title, one-line summary, coordinates."""
     return list_scenes()
+
+
+@router.get(
+    "/catalog",
+    summary="Every built-in scene with what its catalog drawing needs",
+    responses={200: {"description": "id, title, spec and a 1-second run per scene"}},
+)
+async def get_catalog(request: Request) -> Response:
+    """The catalog page draws every scene at its start with a faint line of its first second of
+    motion: one answer carries each scene's spec and that short run (t, positions, frames), so the
+    page makes one request instead of two per scene. Computed once per process."""
+    body, etag = await run_in_threadpool(_catalog)
+    return _cached(request, body, etag, "application/json", REVALIDATE)
+
+
+@functools.lru_cache(maxsize=1)
+def _catalog() -> tuple[bytes, str]:
+    import hashlib
+
+    import orjson
+
+    from mechanics.simulate import SimulationRequest, simulate
+
+    entries: list[dict[str, Any]] = []
+    for s in list_scenes():
+        entry: dict[str, Any] = {**s, "spec": load_scene(s["id"])}
+        try:
+            run = simulate(
+                s["id"], None, SimulationRequest(t_end=1.0, fps=30.0, check_sensitivity=False)
+            )
+            entry["run"] = {k: run[k] for k in ("t", "positions", "frames")}
+        except Exception:  # noqa: BLE001 — one scene without a drawing must not blank the rest
+            entry["run"] = None
+        entries.append(entry)
+    body = orjson.dumps(entries, option=orjson.OPT_SERIALIZE_NUMPY)
+    return body, hashlib.sha256(body).hexdigest()[:16]
 
 
 @router.get(
@@ -35,3 +83,65 @@ def get_scene(scene_id: str) -> SceneDetail:
     except KeyError:
         raise unknown_scene(scene_id) from None
     return SceneDetail.model_validate({"id": scene_id, "spec": spec})
+
+
+@router.get(
+    "/{scene_id}/live",
+    responses={404: {"model": Message}, 503: {"model": Message}},
+    summary="The scene's equations for the browser: the module's URL and its slots' names",
+)
+async def get_live(scene_id: str, request: Request) -> Response:
+    """Where the scene's generated JavaScript module is (a URL carrying its content hash, cached
+    for a year) and the names of its slots in order: coordinates (y = [q, q̇, W_NC…]),
+    parameters (p), the points ``places`` fills and the frames ``axes`` fills. The page steps
+    these equations itself for a live preview while a slider moves; the server's run stays the
+    measured one."""
+    live = await _live(scene_id)
+    body = {
+        "module": f"/api/v1/scenes/{scene_id}/live.js?v={live.digest}",
+        "coordinates": live.coordinates,
+        "parameters": live.parameters,
+        "points": live.points,
+        "frames": live.frames,
+        "solved": live.solved,
+        "extras": live.extras,
+    }
+    import orjson
+
+    return _cached(request, orjson.dumps(body), live.digest, "application/json", REVALIDATE)
+
+
+@router.get(
+    "/{scene_id}/live.js",
+    responses={404: {"model": Message}, 503: {"model": Message}},
+    summary="The scene's equations as an ES module (rhs, places, axes, energy over slots)",
+)
+async def get_live_module(scene_id: str, request: Request, v: str = "") -> Response:
+    """The module itself, ``text/javascript`` so a page imports it under its CSP ('self')
+    without eval. Asked for with its current hash (``?v=``, from ``/live``) it is immutable."""
+    live = await _live(scene_id)
+    policy = IMMUTABLE if v == live.digest else REVALIDATE
+    return _cached(request, live.source.encode(), live.digest, "text/javascript", policy)
+
+
+async def _live(scene_id: str):
+    if scene_id not in scene_ids():
+        raise unknown_scene(scene_id)
+    from mechanics.jscode import JsUnavailable, scene_live_module
+
+    try:
+        return await run_in_threadpool(scene_live_module, scene_id)
+    except JsUnavailable as exc:
+        raise HTTPException(status_code=503, detail=f"no live preview: {exc}") from None
+
+
+def _cached(request: Request, body: bytes, etag: str, media_type: str, policy: str) -> Response:
+    """``body`` with its ETag and caching policy, or a 304 when the client already has it."""
+    tag = f'"{etag}"'
+    headers = {"ETag": tag, "Cache-Control": policy}
+    seen = [
+        t.strip().removeprefix("W/") for t in request.headers.get("if-none-match", "").split(",")
+    ]
+    if tag in seen:
+        return Response(status_code=304, headers=headers)
+    return Response(body, media_type=media_type, headers=headers)
