@@ -324,8 +324,13 @@ class CheckResponse(BaseModel):
     """The verdict and feedback that points at the error."""
 
     correct: bool
-    feedback: list[str]
-    answer_latex: str = Field(description="What the answer was read as, in LaTeX.")
+    feedback: list[str] = Field(
+        description="Sentences that point at the error; their math is inline LaTeX between "
+        "dollar signs (`Sign error in the $\\frac{g}{l} \\sin\\theta$ term.`), never code."
+    )
+    answer_latex: str = Field(
+        description="What the answer was read as, in LaTeX (an equation of motion as lhs = rhs)."
+    )
     expected_latex: str | None = Field(default=None, description="Only with reveal: true.")
 
 

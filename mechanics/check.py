@@ -76,7 +76,12 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
         j = model.coordinate_names.index(coordinate)
     expected = expected_quantity(d, quantity, j)
     given, moved = read_answer(d, quantity, answer, j)
-    verdict = Verdict(False, answer_latex=to_latex(given), expected_latex=_latex(d, quantity, j))
+    shown = to_latex(given)
+    if quantity == "eom":  # an equation reads as one: lhs = rhs as typed, or = 0
+        shown = f"{to_latex(given + moved)} = {to_latex(moved)}"
+    elif quantity == "accel":
+        shown = f"{to_latex(d.model.qdd[j])} = {shown}"
+    verdict = Verdict(False, answer_latex=shown, expected_latex=_latex(d, quantity, j))
     judge = _Judge(d, quantity, j, expected, given, moved)
     judge.run(verdict)
     return verdict

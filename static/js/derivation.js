@@ -77,28 +77,34 @@ function yourTurn(stepId, target, coordinates) {
       <div class="row"><span class="prompt"></span><input type="text" placeholder="e.g. 1/2 m l^2 theta'^2"
       aria-label="your answer"><button type="button" class="check">Check</button>
       <button type="button" class="reveal">Show answer</button></div>
-      <div class="echo"></div><p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div>`;
+      <div class="result" aria-live="polite" aria-atomic="true"><div class="echo"></div>
+      <p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div></div>`;
     box.querySelector(".prompt").textContent = prompt;
     const input = box.querySelector("input");
+    const result = box.querySelector(".result");
+    const verdict = box.querySelector(".verdict");
+    let asked = 0; // only the latest check may fill the box: a slow earlier answer never lands on it
     const ask = async (reveal) => {
+      const mine = ++asked;
       const body = { ...target(), quantity, answer: input.value || "0", reveal };
       if (coordinate) body.coordinate = coordinate;
-      const verdict = box.querySelector(".verdict");
       try {
         const r = await postJSON("/api/v1/check", body);
+        if (mine !== asked) return;
         box.querySelector(".echo").textContent = `read as \\(${r.answer_latex}\\)`;
         verdict.textContent = r.correct ? "✔ Correct" : "✘ Not yet";
         verdict.className = `verdict ${r.correct ? "ok" : "bad"}`;
-        box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: f })));
+        // each feedback sentence carries its math as $…$ (LaTeX), rendered by MathJax
+        box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: inlineMath(f) })));
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
-        await typeset([box]);
+        await typeset([result]);
       } catch (err) {
+        if (mine !== asked) return;
         // an answer that could not be read replaces the previous answer's result, never sits
         // beside it (a stale "✔ Correct" under a new parse error)
         for (const part of [".echo", ".expected"]) box.querySelector(part).textContent = "";
         box.querySelector(".feedback").replaceChildren();
-        verdict.textContent = err.message;
-        verdict.className = "verdict bad";
+        showError(verdict, err.message);
       }
     };
     box.querySelector(".check").addEventListener("click", () => ask(false));
@@ -109,4 +115,19 @@ function yourTurn(stepId, target, coordinates) {
     });
     return box;
   });
+}
+
+/** A refusal from the parser, with the place it points at marked in the text as typed:
+ * "answer: syntax error: … (at character 7: theta ⟨here⟩+)" shows `theta ▸+`. */
+function showError(verdict, message) {
+  verdict.className = "verdict bad";
+  const m = /^(.*) \(at character (\d+): (.*)⟨here⟩(.*)\)$/s.exec(message);
+  if (!m) {
+    verdict.textContent = message;
+    return;
+  }
+  const [, what, at, before, after] = m;
+  const code = el("code", { className: "typed" }, before,
+    el("mark", { textContent: "▸", title: `character ${at}` }), after);
+  verdict.replaceChildren(`${what} at character ${at}: `, code);
 }

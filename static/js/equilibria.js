@@ -1,6 +1,6 @@
 // Equilibria of the scene at the current parameters (POST /api/v1/equilibria): where, whether
 // stable, the small-oscillation frequencies, and buttons that start the motion near one.
-import { postJSON } from "./api.js";
+import { postJSON, typeset } from "./api.js";
 import { SceneGeometry } from "./geometry.js";
 import { fmt } from "./integrator.js";
 import { toSVG } from "./render.js";
@@ -17,6 +17,21 @@ const KIND_WORDS = {
   "marginal": "Marginal: the linear test cannot decide, the nonlinear terms do",
   "unstable": "Unstable: a small displacement grows",
 };
+
+const GREEK = new Set(["alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa",
+  "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi", "omega",
+  "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega"]);
+
+/** A coordinate's name as the derivation writes it: theta1 -> \theta_{1}, x -> x. */
+export function nameTex(name) {
+  const m = /^([A-Za-z]+?)_?(\d*)$/.exec(name);
+  if (!m) return `\\mathrm{${name.replace(/_/g, "\\_")}}`;
+  const base = GREEK.has(m[1]) ? `\\${m[1]}` : m[1];
+  return m[2] ? `${base}_{${m[2]}}` : base;
+}
+
+/** Inline math the page's MathJax renders: \(...\). */
+const inline = (tex) => `\\(${tex}\\)`;
 
 /** A small drawing of the system resting at q (one zero-length run gives the positions). */
 async function sketch(svg, target, parameters, spec, q) {
@@ -46,8 +61,15 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
     const ul = document.createElement("ul");
     for (const e of r.equilibria) {
       const li = document.createElement("li");
-      const where = Object.entries(e.q).map(([k, v]) => `${k} = ${fmt(v)}`).join(", ");
-      const closed = Object.entries(e.symbolic).map(([k, v]) => `${k} = ${v}`).join(", ");
+      const where = Object.entries(e.q).map(([k, v]) => inline(`${nameTex(k)} = ${fmt(v)}`)).join(", ");
+      // the closed form as math (symbolic_latex); the plain `symbolic` only to tell whether it
+      // says more than the numbers do (θ = 0 needs no second line)
+      const latex = e.symbolic_latex || {};
+      const numeric = Object.entries(e.q).map(([k, v]) => `${k} = ${fmt(v)}`).join(", ");
+      const plain = Object.entries(e.symbolic).map(([k, v]) => `${k} = ${v}`).join(", ");
+      const closed = plain && plain !== numeric
+        ? Object.entries(e.symbolic).map(([k, v]) => inline(`${nameTex(k)} = ${latex[k] ?? v}`)).join(", ")
+        : "";
       const kind = e.kind || (e.stable ? "stable" : "unstable");
       li.innerHTML = `<div><span class="where"></span> <span class="tag"></span></div>
         <div class="muted closed"></div><div class="muted freq"></div><div class="muted why"></div><div class="buttons"></div>`;
@@ -66,11 +88,12 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
         li.prepend(svg);
         sketch(svg, target, parameters, spec, e.q);
       }
-      const exists = e.exists_when && e.exists_when !== "always" ? ` (exists when ${e.exists_when})` : "";
-      li.querySelector(".closed").textContent = closed && closed !== where ? closed + exists : exists;
-      if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.join(", ")}`;
+      const condition = e.exists_when_latex || (e.exists_when !== "always" ? e.exists_when : "");
+      const exists = condition ? ` (exists when ${e.exists_when_latex ? inline(condition) : condition})` : "";
+      li.querySelector(".closed").textContent = closed + exists;
+      if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.map((k) => inline(nameTex(k))).join(", ")}`;
       if (e.frequencies.length) {
-        li.querySelector(".freq").textContent = `ω = ${e.frequencies.map((f) => fmt(f)).join(", ")} rad/s`;
+        li.querySelector(".freq").textContent = `${inline(`\\omega = ${e.frequencies.map((f) => fmt(f)).join(", ")}`)} rad/s`;
       }
       const buttons = li.querySelector(".buttons");
       const button = (text, mode) => {
@@ -87,6 +110,7 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       ul.append(li);
     }
     box.replaceChildren(ul);
+    await typeset([ul]);
   } catch (err) {
     box.replaceChildren(Object.assign(document.createElement("p"), { className: "muted", textContent: err.message }));
   }
