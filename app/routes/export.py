@@ -1,0 +1,523 @@
+"""``/api/v1/export/...``: take a scene with you — its derivation as LaTeX, a run as a standalone
+Python script, a trajectory as CSV or JSON, the spec as TOML or JSON, and the page's state as a
+link.
+
+Each export exists as a POST taking the body of the matching API call (``/derive``'s for the
+derivation and the spec, ``/simulate``'s for a run), for built-in scenes and posted specs alike,
+and as a GET for built-in scenes taking the scene page's own query string (``?m=2&theta=1.2&
+method=rk4&dt=0.01&t_end=5``), so the page links to them as they are. Work on a posted spec runs
+where the API's other work on it runs: sympy in the worker pool under its time budget, a
+simulation through /simulate's own path; a built-in scene's through the in-process gate.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Annotated, Any, Literal
+from urllib.parse import urlencode
+
+import orjson
+from fastapi import APIRouter, HTTPException, Query, Request, Response
+from fastapi.responses import RedirectResponse
+from pydantic import BaseModel, ConfigDict, Field, StringConstraints, ValidationError
+from starlette.concurrency import run_in_threadpool
+
+from app import derivations
+from app.routes.scenes import unknown_scene
+from app.routes.simulate import post_simulate
+from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
+from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
+from mechanics.export_share import ShareError, decode_state, encode_state
+from mechanics.integrators import METHODS
+from mechanics.scenes import load_scene, scene_ids
+from mechanics.spec import IDENT, MAX_COORDINATES, MAX_PARAMETERS
+
+#: One router for the exports under /api/v1/export and the share link /s/{token} (a page URL),
+#: so the app includes it once.
+router = APIRouter(tags=["export"])
+API = "/api/v1/export"
+
+_ERRORS: dict[int | str, dict[str, Any]] = {
+    404: {"model": ValidationErrors, "description": "Unknown scene_id."},
+    422: {"model": ValidationErrors, "description": "A field is invalid (named in the answer)."},
+    503: {"model": ValidationErrors, "description": "The work ran past its time budget."},
+}
+TEX = "application/x-tex"
+PYTHON = "text/x-python; charset=utf-8"
+CSV = "text/csv; charset=utf-8"
+TOML = "application/toml; charset=utf-8"
+#: Longest a page query string may be for the GET exports (characters): a scene has at most
+#: 40 parameters and 12 initial values, each well under 60 characters.
+MAX_QUERY = 4096
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+Name = Annotated[str, StringConstraints(pattern=IDENT)]
+StateName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,27}$")]
+
+
+def _download(content: str | bytes, media_type: str, filename: str) -> Response:
+    """An attachment: the browser saves it under ``filename`` instead of showing it."""
+    return Response(
+        content=content,
+        media_type=media_type,
+        headers={"Content-Disposition": f'attachment; filename="{filename}"'},
+    )
+
+
+def _file_stem(request: DeriveRequest) -> str:
+    return request.scene_id or "scene"
+
+
+# --------------------------------------------------------------------------------- LaTeX
+
+
+@router.post(
+    API + "/latex",
+    response_class=Response,
+    responses={200: {"content": {TEX: {}}, "description": "A LaTeX article."}, **_ERRORS},
+    summary="The derivation as a LaTeX document",
+)
+async def post_latex(request: DeriveRequest, http: Request) -> Response:
+    """The whole derivation as a LaTeX article that compiles with `pdflatex` (no shell escape
+    needed): the notes' procedure, every step with its prose and equations, the values, and the
+    free-body diagram drawn at the initial state. Text from a posted spec is escaped: it prints,
+    it never runs."""
+    return _download(await _latex(request, http), TEX, f"{_file_stem(request)}.tex")
+
+
+@router.get(
+    API + "/scenes/{scene_id}/derivation.tex",
+    response_class=Response,
+    responses={200: {"content": {TEX: {}}, "description": "A LaTeX article."}, **_ERRORS},
+    summary="A built-in scene's derivation as LaTeX",
+)
+async def get_latex(scene_id: SceneId, http: Request) -> Response:
+    """The same document as `POST /api/v1/export/latex` with `{"scene_id": ...}`."""
+    request = DeriveRequest(scene_id=scene_id)
+    return _download(await _latex(request, http), TEX, f"{scene_id}.tex")
+
+
+async def _latex(request: DeriveRequest, http: Request) -> str:
+    from mechanics.export_latex import document_of
+
+    if request.scene_id is not None:
+        _known(request.scene_id)
+        return await derivations.in_process(
+            http, document_of, request.scene_id, None, what="LaTeX export"
+        )
+    key = await run_in_threadpool(derivations.posted_key, request.scene)
+    return await run_in_threadpool(
+        derivations.in_pool,
+        http,
+        document_of,
+        None,
+        key,
+        affinity=key,
+        what="writing this scene's derivation as LaTeX",
+    )
+
+
+def _known(scene_id: str) -> None:
+    if scene_id not in scene_ids():
+        raise unknown_scene(scene_id)
+
+
+# --------------------------------------------------------------------------------- script
+
+
+@router.post(
+    API + "/script",
+    response_class=Response,
+    responses={200: {"content": {"text/x-python": {}}, "description": "A script."}, **_ERRORS},
+    summary="A run as a standalone Python script",
+)
+async def post_script(request: SimulateRequest, http: Request) -> Response:
+    """A Python script (numpy and scipy only) that reproduces this `/simulate` request: the
+    scene's equations of motion as code, its parameters, initial state, method, tolerances (or
+    step) and sample times. `python run.py --json out.json` writes t, q and q_dot. It
+    integrates the same state with the same right-hand side, so it agrees with the API's run to
+    the run's tolerance. (Stop conditions are listed in it, not applied.)"""
+    return _download(await _script(request, http), PYTHON, f"{_file_stem(request)}_run.py")
+
+
+@router.get(
+    API + "/scenes/{scene_id}/run.py",
+    response_class=Response,
+    responses={200: {"content": {"text/x-python": {}}, "description": "A script."}, **_ERRORS},
+    summary="A built-in scene's run as a Python script (page query string)",
+)
+async def get_script(scene_id: SceneId, http: Request) -> Response:
+    """`POST /api/v1/export/script` for a built-in scene, with the scene page's query string
+    (parameter and initial values by name, `method`, `tol`, `dt`, `t_end`)."""
+    request = _page_request(scene_id, http)
+    return _download(await _script(request, http), PYTHON, f"{scene_id}_run.py")
+
+
+async def _script(request: SimulateRequest, http: Request) -> str:
+    from mechanics.export_script import run_script
+    from mechanics.simulate import SimulationRequest
+
+    options = SimulationRequest(
+        **request.model_dump(include=set(SimulationRequest.__dataclass_fields__))
+    )
+    if request.scene_id is not None:
+        _known(request.scene_id)
+        origin = f"Lagrange Lab, built-in scene {request.scene_id}"
+        return await derivations.in_process(
+            http, run_script, request.scene_id, None, options, origin, what="script export"
+        )
+    key = await run_in_threadpool(derivations.posted_key, request.scene)
+    return await run_in_threadpool(
+        derivations.in_pool,
+        http,
+        run_script,
+        None,
+        key,
+        options,
+        "Lagrange Lab, a posted scene",
+        affinity=key,
+        what="writing this run as a script",
+    )
+
+
+# ----------------------------------------------------------------------------- trajectory
+
+TrajectoryFormat = Literal["csv", "json"]
+
+
+@router.post(
+    API + "/trajectory",
+    response_class=Response,
+    responses={
+        200: {"content": {"text/csv": {}, "application/json": {}}, "description": "The run."},
+        **_ERRORS,
+    },
+    summary="A run's trajectory as CSV or JSON, with its stats",
+)
+async def post_trajectory(
+    request: SimulateRequest,
+    http: Request,
+    format: Annotated[TrajectoryFormat, Query(description="csv or json")] = "csv",
+) -> Response:
+    """Runs the `/simulate` request and answers its trajectory as a file: t, each q and q̇,
+    T, V, E, W_nc and W_drive per sample, headed by name and unit; the run's stats and warnings
+    as `#` comment lines (CSV) or fields (JSON)."""
+    return await _trajectory(request, http, format)
+
+
+@router.get(
+    API + "/scenes/{scene_id}/trajectory.{format}",
+    response_class=Response,
+    responses={
+        200: {"content": {"text/csv": {}, "application/json": {}}, "description": "The run."},
+        **_ERRORS,
+    },
+    summary="A built-in scene's trajectory as CSV or JSON (page query string)",
+)
+async def get_trajectory(scene_id: SceneId, format: TrajectoryFormat, http: Request) -> Response:
+    """`POST /api/v1/export/trajectory` for a built-in scene, with the page's query string."""
+    return await _trajectory(_page_request(scene_id, http), http, format)
+
+
+async def _trajectory(request: SimulateRequest, http: Request, format: str) -> Response:
+    if request.scene_id is not None:
+        _known(request.scene_id)
+        spec: dict[str, Any] = load_scene(request.scene_id)
+    else:
+        spec = request.scene.model_dump(mode="json", by_alias=True)
+    answer = await post_simulate(request, http)
+    run = orjson.loads(answer.body)
+    units = spec.get("units") or {}
+    stem = _file_stem(request)
+    described = {
+        "scene": request.scene_id or spec.get("title"),
+        "method": request.method,
+        **({"dt": request.dt} if METHODS[request.method].kind == "fixed" else {}),
+        **(
+            {"rtol": request.rtol, "atol": request.atol}
+            if METHODS[request.method].kind == "adaptive"
+            else {}
+        ),
+        "t_end": request.t_end,
+        "fps": request.fps,
+        "parameters": {**spec.get("parameters", {}), **request.parameters},
+        "initial": _initial_of(spec, request.initial),
+    }
+    if format == "json":
+        body = {
+            "request": described,
+            "columns": [{"name": n, "unit": u} for n, u in trajectory_columns(run, units)],
+            **{k: run[k] for k in ("t", "q", "q_dot", "energy", "stats", "warnings")},
+        }
+        return _download(orjson.dumps(body), "application/json", f"{stem}_trajectory.json")
+    comments = [f"Lagrange Lab trajectory of {described['scene']}"]
+    comments += [f"{k}: {json.dumps(v, ensure_ascii=False)}" for k, v in described.items()]
+    comments += stats_lines(run["stats"]) + [f"warning: {w}" for w in run["warnings"]]
+    return _download(trajectory_csv(run, units, comments), CSV, f"{stem}_trajectory.csv")
+
+
+def _initial_of(spec: dict[str, Any], overrides: dict[str, float]) -> dict[str, float]:
+    initial = spec.get("initial") or {}
+    out = {}
+    for q in spec.get("coordinates") or []:
+        for key in (q, f"{q}_dot"):
+            out[key] = overrides.get(key, initial.get(key, 0.0))
+    return out
+
+
+# ----------------------------------------------------------------------------------- spec
+
+SpecFormat = Literal["toml", "json"]
+
+
+@router.post(
+    API + "/spec",
+    response_class=Response,
+    responses={
+        200: {"content": {"application/toml": {}, "application/json": {}}, "description": "."},
+        **_ERRORS,
+    },
+    summary="A scene's spec as TOML or JSON",
+)
+async def post_spec(
+    request: DeriveRequest,
+    format: Annotated[SpecFormat, Query(description="toml or json")] = "toml",
+) -> Response:
+    """The spec of a built-in scene (as written in its file) or a posted one (as validated,
+    defaults left out), as TOML (`tomllib` reads it back equal) or JSON: ready to edit and post
+    to `/api/v1/derive`."""
+    if request.scene_id is not None:
+        return _spec_file(_builtin_spec(request.scene_id), format, request.scene_id)
+    spec = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    return _spec_file(spec, format, "scene")
+
+
+@router.get(
+    API + "/scenes/{scene_id}/spec.{format}",
+    response_class=Response,
+    responses={
+        200: {"content": {"application/toml": {}, "application/json": {}}, "description": "."},
+        **_ERRORS,
+    },
+    summary="A built-in scene's spec as TOML or JSON",
+)
+def get_spec(scene_id: SceneId, format: SpecFormat) -> Response:
+    """The same as `POST /api/v1/export/spec` with `{"scene_id": ...}`."""
+    return _spec_file(_builtin_spec(scene_id), format, scene_id)
+
+
+def _builtin_spec(scene_id: str) -> dict[str, Any]:
+    try:
+        return load_scene(scene_id)
+    except KeyError:
+        raise unknown_scene(scene_id) from None
+
+
+def _spec_file(spec: dict[str, Any], format: str, stem: str) -> Response:
+    if format == "toml":
+        return _download(spec_toml(spec), TOML, f"{stem}.toml")
+    text = json.dumps(spec, indent=2, ensure_ascii=False) + "\n"
+    return _download(text, "application/json", f"{stem}.json")
+
+
+# ---------------------------------------------------------------------------------- share
+
+
+class ShareState(DeriveRequest):
+    """What a scene's page shows, to restore exactly from a link: the scene (a built-in one's id
+    or a posted spec), the sliders, the integrator, the time span and the lecture step."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {
+                    "scene_id": "double_pendulum",
+                    "parameters": {"m2": 2.0},
+                    "initial": {"theta1": 1.2},
+                    "method": "rk4",
+                    "dt": 0.005,
+                    "t_end": 15,
+                    "lecture": True,
+                    "lecture_step": 4,
+                }
+            ]
+        },
+    )
+
+    parameters: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_PARAMETERS)] = {}
+    initial: Annotated[dict[StateName, FiniteFloat], Field(max_length=2 * MAX_COORDINATES)] = {}
+    method: MethodName = "dop853_c"  # type: ignore[valid-type]
+    rtol: FiniteFloat | None = Field(default=None, ge=1e-14, le=0.1)
+    atol: FiniteFloat | None = Field(default=None, ge=1e-16, le=1.0)
+    dt: FiniteFloat | None = Field(default=None, gt=0, le=1000)
+    t_end: FiniteFloat = Field(default=10.0, ge=0, le=1000)
+    compare: bool = False
+    method_b: MethodName | None = None  # type: ignore[valid-type]
+    lecture: bool = False
+    lecture_step: int | None = Field(default=None, ge=0, le=63, description="0 = the first step.")
+    phase: Name | None = Field(default=None, description="The coordinate of the phase plot.")
+
+
+class ShareLink(BaseModel):
+    token: str = Field(description="The state, compressed (zlib + base64url); nothing is stored.")
+    url: str = Field(description="The link to share: /s/{token} opens the page in this state.")
+    api: str = Field(description="GET it for the state as JSON.")
+
+
+@router.post(
+    API + "/share",
+    response_model=ShareLink,
+    responses={422: _ERRORS[422]},
+    summary="A link that restores a page's state",
+)
+def post_share(state: ShareState) -> ShareLink:
+    """The state compressed into a URL: the link carries the scene (a posted spec too), the
+    parameters, initial state, method, tolerances or step, t_end and lecture step, with every
+    number exact. Nothing is stored on the server, so it works on any server, forever."""
+    document = state.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    try:
+        token = encode_state(document)
+    except (ShareError, ValueError) as exc:
+        raise HTTPException(422, [{"field": "scene", "message": str(exc)}]) from None
+    return ShareLink(token=token, url=f"/s/{token}", api=f"/api/v1/export/share/{token}")
+
+
+@router.get(
+    API + "/share/{token}",
+    response_model=ShareState,
+    response_model_exclude_unset=True,
+    responses={422: _ERRORS[422]},
+    summary="The state a share link carries",
+)
+def get_share(token: str) -> ShareState:
+    """The state of `/s/{token}`, as JSON (what the page restores). A token this app did not
+    write answers 422 naming what is wrong with it."""
+    return _decoded(token)
+
+
+@router.get(
+    "/s/{token}",
+    response_class=RedirectResponse,
+    status_code=303,
+    responses={422: _ERRORS[422]},
+    summary="Open a shared link",
+)
+def open_share(token: str) -> RedirectResponse:
+    """Redirects to the page in the shared state: a built-in scene's page with its query
+    string (`step` is the lecture step), or, for a posted spec, the editor with `?share=token`
+    (the editor reads the state from `/api/v1/export/share/{token}`)."""
+    state = _decoded(token)
+    if state.scene_id is None:
+        return RedirectResponse(f"/editor?{urlencode({'share': token})}", status_code=303)
+    return RedirectResponse(f"/scenes/{state.scene_id}?{page_query(state)}", status_code=303)
+
+
+def _decoded(token: str) -> ShareState:
+    try:
+        document = decode_state(token)
+        return ShareState.model_validate(document)
+    except ShareError as exc:
+        raise HTTPException(422, [{"field": "token", "message": str(exc)}]) from None
+    except ValidationError as exc:
+        problems = [
+            {
+                "field": ".".join(["token", *(str(p) for p in e["loc"])]),
+                "message": e["msg"],
+            }
+            for e in exc.errors()
+        ]
+        raise HTTPException(422, problems) from None
+
+
+def page_query(state: ShareState) -> str:
+    """The scene page's query string for ``state`` (static/js/controls.js writeQuery's keys;
+    numbers written with repr, which the page reads back as the same doubles)."""
+    query: list[tuple[str, str]] = []
+    query += [(k, repr(v)) for k, v in state.parameters.items()]
+    query += [(k, repr(v)) for k, v in state.initial.items()]
+    query.append(("method", state.method))
+    if state.dt is not None:
+        query.append(("dt", repr(state.dt)))
+    if state.rtol is not None:
+        query.append(("tol", repr(state.rtol)))
+    if state.atol is not None and state.atol != state.rtol:
+        query.append(("atol", repr(state.atol)))
+    query.append(("t_end", repr(state.t_end)))
+    if state.compare:
+        query.append(("compare", "1"))
+    if state.method_b is not None:
+        query.append(("method_b", state.method_b))
+    if state.lecture:
+        query.append(("lecture", "1"))
+    if state.lecture_step is not None:
+        query.append(("step", str(state.lecture_step)))
+    if state.phase is not None:
+        query.append(("phase", state.phase))
+    return urlencode(query)
+
+
+# ------------------------------------------------------------------------ page query string
+
+#: Keys of the page's query string that are not values of the scene.
+_PAGE_SETTINGS = {"method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture"}
+_PAGE_SETTINGS |= {"phase", "step", "from", "fps"}
+
+
+def _page_request(scene_id: str, http: Request) -> SimulateRequest:
+    """The /simulate request a scene page's query string describes (see static/js/controls.js
+    writeQuery): values by name, ``method``, ``tol`` (rtol and atol), ``dt``, ``t_end``. Keys
+    that name nothing in the scene are ignored, as the page ignores them; a value that is not a
+    finite number is a 422 naming it."""
+    _known(scene_id)
+    if len(http.url.query) > MAX_QUERY:
+        raise HTTPException(422, [{"field": "query", "message": f"over {MAX_QUERY} characters"}])
+    spec = load_scene(scene_id)
+    names_p = set(spec.get("parameters") or {})
+    names_i = {n for q in spec["coordinates"] for n in (q, f"{q}_dot")}
+    query = http.query_params
+    errors: list[dict[str, str]] = []
+
+    def number(key: str) -> float | None:
+        raw = query.get(key)
+        if raw is None or raw == "":
+            return None
+        try:
+            value = float(raw)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            errors.append({"field": key, "message": f"must be a finite number, not {raw[:40]!r}"})
+            return None
+        return value
+
+    fields: dict[str, Any] = {"scene_id": scene_id, "parameters": {}, "initial": {}}
+    for key in query:
+        if key in names_p and (v := number(key)) is not None:
+            fields["parameters"][key] = v
+        elif key in names_i and (v := number(key)) is not None:
+            fields["initial"][key] = v
+    method = query.get("method") or "dop853_c"
+    if method not in METHODS:
+        errors.append(
+            {"field": "method", "message": f"unknown method; one of {', '.join(METHODS)}"}
+        )
+    fields["method"] = method
+    for key, target in (("tol", "rtol"), ("tol", "atol"), ("atol", "atol"), ("t_end", "t_end")):
+        if (v := number(key)) is not None:
+            fields[target] = v
+    if method in METHODS and METHODS[method].kind == "fixed":
+        fields["dt"] = number("dt") or 0.01  # the page's default step
+    if (v := number("fps")) is not None:
+        fields["fps"] = v
+    if errors:
+        raise HTTPException(422, errors)
+    try:
+        return SimulateRequest.model_validate(fields)
+    except ValidationError as exc:
+        problems = [
+            {"field": ".".join(str(p) for p in e["loc"]) or "query", "message": e["msg"]}
+            for e in exc.errors()
+        ]
+        raise HTTPException(422, problems) from None

@@ -1,0 +1,149 @@
+"""A scene's spec as TOML, a run's trajectory as CSV: the files a student takes away.
+
+TOML is written here, not by a library: the standard library reads TOML (tomllib) but does not
+write it, and a spec's shape is small (scalars, lists, tables, arrays of tables). Every float is
+written with ``repr`` (the shortest text that reads back as the same double), so
+``tomllib.loads(spec_toml(spec)) == spec`` holds exactly, and every string is a TOML basic string
+with its quotes, backslashes and control characters escaped.
+
+    >>> print(spec_toml({"title": 'A "quoted" pendulum', "parameters": {"l": 0.1}}))
+    title = "A \\"quoted\\" pendulum"
+    parameters = { l = 0.1 }
+    <BLANKLINE>
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import re
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f"}
+_ESCAPES["\r"] = "\\r"
+
+
+class TomlError(ValueError):
+    """A value TOML cannot hold (None inside a list, a type that is not data)."""
+
+
+def toml_string(text: str) -> str:
+    """A TOML basic string: quotes, backslashes and control characters escaped, the rest as is."""
+    out = []
+    for ch in text:
+        if ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
+def toml_key(key: str) -> str:
+    return key if _BARE_KEY.match(key) else toml_string(key)
+
+
+def toml_value(value: Any) -> str:
+    """One value inline: arrays as [...], tables as { ... }."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return toml_string(value)
+    if isinstance(value, Mapping):
+        items = [f"{toml_key(k)} = {toml_value(v)}" for k, v in value.items() if v is not None]
+        return "{ " + ", ".join(items) + " }" if items else "{}"
+    if isinstance(value, list | tuple):
+        if any(v is None for v in value):
+            raise TomlError("TOML has no null: a list holds None")
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    raise TomlError(f"TOML cannot hold a {type(value).__name__}")
+
+
+def spec_toml(spec: Mapping[str, Any]) -> str:
+    """The spec as a TOML document: top-level keys first, then each list of tables (bodies,
+    springs, ...) as ``[[name]]`` sections; nested tables inside them are written inline."""
+    head, sections = [], []
+    for key, value in spec.items():
+        if value is None:
+            continue
+        if _is_table_array(value):
+            for table in value:
+                lines = [f"{toml_key(k)} = {toml_value(v)}" for k, v in table.items()]
+                sections.append(f"\n[[{toml_key(key)}]]\n" + "".join(f"{x}\n" for x in lines))
+        else:
+            head.append(f"{toml_key(key)} = {toml_value(value)}\n")
+    return "".join(head) + "".join(sections)
+
+
+def _is_table_array(value: Any) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, Mapping) for v in value)
+
+
+# ---------------------------------------------------------------------------- trajectory as CSV
+
+ENERGY_COLUMNS = ("T", "V", "E", "W_nc", "W_drive")
+
+
+def trajectory_columns(run: Mapping[str, Any], units: Mapping[str, str]) -> list[tuple[str, str]]:
+    """(column, unit) in order: t, each q, each q̇, the energies. A coordinate's unit is the
+    scene's (``units``); energies are in J when the scene declares units at all (SI), else ""."""
+    columns = [("t", "s")]
+    for q in run["q"]:
+        columns.append((q, units.get(q, "")))
+    for q in run["q_dot"]:
+        unit = units.get(q, "")
+        columns.append(
+            (f"{q}_dot", f"{unit}/s" if unit and unit != "1" else ("1/s" if unit else ""))
+        )
+    energy = "J" if units else ""
+    columns += [(name, energy) for name in ENERGY_COLUMNS if name in run.get("energy", {})]
+    return columns
+
+
+def _series(run: Mapping[str, Any], column: str) -> list[Any]:
+    if column == "t":
+        return run["t"]
+    if column in run["q"]:
+        return run["q"][column]
+    if column.endswith("_dot") and column[:-4] in run["q_dot"]:
+        return run["q_dot"][column[:-4]]
+    return run["energy"][column]
+
+
+def trajectory_csv(
+    run: Mapping[str, Any], units: Mapping[str, str], comments: Iterable[str] = ()
+) -> str:
+    """The run as CSV: ``#`` comment lines (what was run, its stats: numpy.loadtxt and pandas'
+    ``comment="#"`` skip them), a header ``name [unit]``, one row per sample. Numbers are written
+    with ``repr`` (they read back as the same doubles); a missing value (null) as ``nan``."""
+    columns = trajectory_columns(run, units)
+    out = io.StringIO()
+    for line in comments:
+        out.write("# " + line.replace("\n", " ").replace("\r", " ") + "\n")
+    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in columns) + "\n")
+    series = [_series(run, name) for name, _ in columns]
+    for row in zip(*series, strict=True):
+        out.write(",".join("nan" if v is None else repr(float(v)) for v in row) + "\n")
+    return out.getvalue()
+
+
+def stats_lines(stats: Mapping[str, Any], prefix: str = "stats.") -> list[str]:
+    """A run's stats flattened as ``key: value`` lines (nested dicts with dotted keys)."""
+    lines = []
+    for key, value in stats.items():
+        if isinstance(value, Mapping):
+            lines += stats_lines(value, f"{prefix}{key}.")
+        else:
+            lines.append(f"{prefix}{key}: {value}")
+    return lines
