@@ -1,6 +1,7 @@
 // The catalog's drawings: each scene at its initial configuration (SVG), with a faint line showing
-// where its first second of motion takes it.
-import { getJSON, postJSON } from "./api.js";
+// where its first second of motion takes it. One request brings every scene's spec and short run
+// (GET /api/v1/scenes/catalog), instead of two per scene.
+import { getJSON } from "./api.js";
 import { SceneGeometry } from "./geometry.js";
 import { toSVG } from "./render.js";
 import { sceneShapes } from "./shapes.js";
@@ -8,14 +9,10 @@ import { View } from "./view.js";
 
 const W = 240, H = 150;
 
-async function drawOne(svg) {
-  const id = svg.dataset.thumb;
+function drawOne(svg, entry) {
   try {
-    const [{ spec }, run] = await Promise.all([
-      getJSON(`/api/v1/scenes/${id}`),
-      postJSON("/api/v1/simulate", { scene_id: id, t_end: 1, fps: 30, check_sensitivity: false }),
-    ]);
-    const geom = new SceneGeometry(spec, run);
+    if (!entry || !entry.run) throw new Error("no run");
+    const geom = new SceneGeometry(entry.spec, entry.run);
     const view = new View(W, H, geom.is3D).fit(geom.extent(), geom.is3D ? 10 : 22);
     svg.innerHTML = toSVG(sceneShapes(geom, view, 0, { radius: 7, path: true, axes: false }));
     svg.dataset.ready = "1";
@@ -26,7 +23,13 @@ async function drawOne(svg) {
 }
 
 export async function drawThumbnails() {
-  const queue = [...document.querySelectorAll("svg[data-thumb]")];
-  const worker = async () => { while (queue.length) await drawOne(queue.shift()); };
-  await Promise.all([worker(), worker(), worker()]);
+  const svgs = [...document.querySelectorAll("svg[data-thumb]")];
+  let entries = [];
+  try {
+    entries = await getJSON("/api/v1/scenes/catalog");
+  } catch (err) {
+    entries = [];
+  }
+  const byId = new Map(entries.map((e) => [e.id, e]));
+  for (const svg of svgs) drawOne(svg, byId.get(svg.dataset.thumb));
 }

@@ -48,8 +48,10 @@ export function writeQuery({ params, initial, settings, fixed, lecture }) {
   return q.toString();
 }
 
-/** Build the rows of sliders; `onChange(name, value)` fires on every move (the caller debounces). */
-export function buildControls(box, rows, onChange) {
+/** Build the rows of sliders; `onChange(name, value)` fires on every move (the caller debounces,
+ * or previews live), `onCommit(name, value)` when a value is settled: a slider let go, a number
+ * entered. */
+export function buildControls(box, rows, onChange, onCommit = () => {}) {
   box.replaceChildren();
   for (const { name, value, unit, angle, positive } of rows) {
     const [lo, hi] = sliderRange(value, { angle, positive });
@@ -69,6 +71,7 @@ export function buildControls(box, rows, onChange) {
       number.value = slider.value;
       onChange(name, Number(slider.value));
     });
+    slider.addEventListener("change", () => onCommit(name, Number(slider.value)));
     number.addEventListener("change", () => {
       const v = Number(number.value);
       if (number.value === "" || !Number.isFinite(v)) return;
@@ -76,6 +79,7 @@ export function buildControls(box, rows, onChange) {
       if (v > Number(slider.max)) slider.max = v;
       slider.value = v;
       onChange(name, v);
+      onCommit(name, v);
     });
     box.append(row);
   }

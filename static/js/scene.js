@@ -1,6 +1,12 @@
 // A scene's page: the derivation step by step, the motion animated, the controls, the integrator,
 // the plots, the free-body diagram and lecture mode. Used by /scenes/{id} (a built-in scene) and by
 // the editor (a posted spec): one class, fed either a scene id or a spec.
+//
+// A built-in scene also gets its equations as JavaScript (live.js): the animation then starts from
+// a preview stepped in the browser before the server's run arrives, follows a slider while it
+// moves, and lets a body be dragged to its starting place. The preview is labelled as such until
+// the server's run (the measured one, which the integrator panel, plots and compare mode show)
+// replaces it; the server is asked when a slider is let go.
 import { getJSON, postJSON, typeset } from "./api.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
 import { renderSteps } from "./derivation.js";
@@ -9,6 +15,9 @@ import { showEquilibria } from "./equilibria.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
 import { isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
 import { Lecture } from "./lecture.js";
+import { LiveModel, PREVIEW_LABEL } from "./live.js";
+import { BodyDrag } from "./livedrag.js";
+import { loadPlotly } from "./lazy.js";
 import { plotRun, plotlyReady } from "./plots.js";
 import { showWork, watchWorkInputs } from "./work.js";
 
@@ -27,8 +36,12 @@ class SceneView {
     this.speed = 1;
     this.time = 0;
     this.runs = 0;
-    this.result = null;
+    this.result = null; // the server's run: what the panel, the plots and the FBD show
     this.resultB = null;
+    this.shown = null; // what canvas A draws: the server's run or the live preview
+    this.live = null;
+    this.changes = 0; // every change of a value, so a server run can tell it is behind
+    this.previews = 0;
   }
 
   target() {
@@ -36,13 +49,26 @@ class SceneView {
   }
 
   async start(spec, derivation) {
-    if (this.sceneId) spec = (await getJSON(`/api/v1/scenes/${this.sceneId}`)).spec;
+    // Everything a built-in scene needs is asked for at once: the spec, the derivation and the
+    // live equations do not wait for each other.
+    let derived = derivation;
+    if (this.sceneId) {
+      derived = derivation || postJSON("/api/v1/derive", this.target());
+      derived.catch?.(() => {}); // shown by derive(); not an unhandled rejection meanwhile
+      LiveModel.load(this.sceneId)
+        .then((live) => { this.live = live; this.preview(); })
+        .catch((err) => { $("canvas").dataset.live = `unavailable: ${err.message}`; });
+    }
+    const specP = this.sceneId ? getJSON(`/api/v1/scenes/${this.sceneId}`) : null;
     const query = new URLSearchParams(location.search);
     this.settings = readSettings(query);
     this.phase = query.get("phase");
     mountIntegrator(this.settings, () => this.schedule());
     this.stageA = new Stage($("canvas"));
     this.stageB = new Stage($("canvas-b"));
+    this.badge = liveBadge();
+    this.#waiting("Computing the motion…");
+    this.#syncPlay();
     this.#playback();
     this.lecture = new Lecture({
       list: $("steps"), toggle: $("lecture-toggle"), counter: $("step-counter"),
@@ -52,8 +78,10 @@ class SceneView {
     watchWorkInputs(() => this.#plot());
     $("phase-q").addEventListener("change", () => { this.phase = $("phase-q").value; this.#saveURL(); this.#plot(); });
     $("reset").addEventListener("click", () => this.#reset());
+    this.drag = new BodyDrag(this);
     this.#loop();
-    await this.load(spec, query, derivation);
+    if (specP) spec = (await specP).spec;
+    await this.load(spec, query, derived);
   }
 
   /** A new spec (first load, or the editor re-derived): controls and results start afresh. */
@@ -69,6 +97,8 @@ class SceneView {
     if (spec.coordinates.includes(this.phase)) $("phase-q").value = this.phase;
     this.result = null;
     this.resultB = null;
+    this.shown = null;
+    this.preview();
     await Promise.all([this.derive(derivation), this.run(), this.equilibria()]);
   }
 
@@ -76,16 +106,35 @@ class SceneView {
   #controls() {
     const units = this.spec.units || {};
     const positive = new Set(this.spec.positive_coordinates || []);
-    const changed = (store) => (name, value) => { store[name] = value; this.schedule(); };
+    // Every move shows at once in the live preview; the server runs when the slider is let go
+    // (without live equations, 300 ms after the last move, as before).
+    const changed = (store) => (name, value) => {
+      store[name] = value;
+      this.changes++;
+      if (this.live) { this.preview(); this.#saveURL(); } else this.schedule();
+    };
+    const commit = () => { if (this.live) this.schedule(0); };
     buildControls($("params"), Object.entries(this.params).map(([name, value]) => ({
       name, value, unit: units[name], positive: value > 0,
-    })), changed(this.params));
+    })), changed(this.params), commit);
     const rows = [];
     for (const q of this.spec.coordinates) {
       rows.push({ name: q, value: this.initial[q], unit: units[q], angle: units[q] === "rad", positive: positive.has(q) });
       rows.push({ name: `${q}_dot`, value: this.initial[`${q}_dot`], unit: units[q] ? `${units[q]}/s` : "" });
     }
-    buildControls($("initial"), rows, changed(this.initial));
+    buildControls($("initial"), rows, changed(this.initial), commit);
+  }
+
+  /** New initial values from a drag on the canvas: controls, URL and the live preview follow. */
+  setInitial(values) {
+    for (const [k, v] of Object.entries(values)) {
+      const x = Number(v.toFixed(6));
+      this.initial[k] = x;
+      setControl(k, x);
+    }
+    this.changes++;
+    this.preview();
+    this.#saveURL();
   }
 
   #reset() {
@@ -93,6 +142,8 @@ class SceneView {
     for (const [k, v] of Object.entries({ ...fresh.params, ...fresh.initial })) setControl(k, v);
     Object.assign(this.params, fresh.params);
     Object.assign(this.initial, fresh.initial);
+    this.changes++;
+    this.preview();
     this.schedule(0);
   }
 
@@ -131,6 +182,7 @@ class SceneView {
 
   async run() {
     const id = ++this.runs;
+    const changes = this.changes;
     this.#saveURL();
     const s = this.settings;
     $("stats").classList.add("busy");
@@ -142,9 +194,11 @@ class SceneView {
       if (id !== this.runs) return; // a newer run superseded this one
       this.result = a;
       this.resultB = b || null;
-      this.stageA.setResult(this.spec, a, this.params);
+      delete $("canvas").dataset.error;
+      // A value moved since this run was asked for: the preview on the canvas is newer; the
+      // panel and the plots take the server's run, the canvas waits for the next one.
+      if (changes === this.changes || !this.live) this.#show(a, "server");
       if (b) this.stageB.setResult(this.spec, b, this.params);
-      this.time = Math.min(this.time, a.t[a.t.length - 1]);
       showStats(b ? [a, b] : [a]);
       $("caption-a").textContent = b ? `A: ${a.stats.method}` : "";
       $("caption-b").textContent = b ? `B: ${b.stats.method}` : "";
@@ -158,6 +212,12 @@ class SceneView {
       if (id !== this.runs) return;
       showWarnings([`The simulation failed: ${err.message}`]);
       $("canvas").dataset.error = err.message;
+      if (this.shown && this.shown !== this.result) { // never leave a preview of a refused state
+        this.shown = null;
+        this.#waiting("No motion: the server refused this state (see the warnings).");
+        this.#label(null);
+        this.#syncPlay();
+      }
     } finally {
       if (id === this.runs) {
         $("stats").classList.remove("busy");
@@ -166,9 +226,84 @@ class SceneView {
     }
   }
 
+  // ------------------------------------------------------------------ the live preview
+  /** Recompute the preview at the next animation frame (a burst of slider events costs one). */
+  preview() {
+    if (this.live && this.spec) this.previewDue = true;
+  }
+
+  #computePreview() {
+    this.previewDue = false;
+    let run;
+    try {
+      run = this.live.run({ params: this.params, initial: this.initial, tEnd: this.settings.t_end, fps: 60 });
+    } catch (err) {
+      $("canvas").dataset.live = `failed: ${err.message}`;
+      this.live = null;
+      return;
+    }
+    this.previews++;
+    this.#show(run, "live");
+  }
+
+  /** Put a run on canvas A: the server's, or the live preview (labelled as one). */
+  #show(run, source) {
+    this.shown = run;
+    this.stageA.setResult(this.spec, run, this.params);
+    this.drag?.freeze();
+    const end = run.t[run.t.length - 1];
+    this.time = Math.min(this.time, end);
+    const c = $("canvas");
+    c.dataset.source = source;
+    if (source === "live") c.dataset.previews = String(this.previews);
+    this.#label(run);
+    this.stageA.draw(this.frameIndex());
+    this.#syncPlay();
+  }
+
+  #label(run) {
+    const b = this.badge;
+    if (!run) { b.hidden = true; return; }
+    b.hidden = false;
+    const st = run.stats;
+    if (st.preview) {
+      b.dataset.kind = "preview";
+      b.textContent = `${PREVIEW_LABEL}, h = ${(st.step * 1000).toPrecision(2)} ms — a preview: `
+        + (this.result ? "the server's run follows when you let go" : "the server's run is on its way");
+      if (st.status !== "ok") b.textContent += ` (stopped early: ${st.status})`;
+      Object.assign(b.style, { background: "#fff3bf", color: "#5c3c00", borderColor: "#f59f00" });
+    } else {
+      b.dataset.kind = "server";
+      const s = this.settings;
+      const how = isFixed(st.method) ? `dt = ${s.dt} s` : `rtol = atol = ${s.tol}`;
+      b.textContent = `server run (${st.method}, ${how})`;
+      Object.assign(b.style, { background: "transparent", color: "inherit", borderColor: "transparent" });
+    }
+  }
+
+  /** Say on the canvas itself what is coming, so it is never blank while the page works. */
+  #waiting(text) {
+    const c = $("canvas");
+    const ctx = c.getContext("2d");
+    const dpr = window.devicePixelRatio || 1;
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, c.width, c.height);
+    ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+    ctx.fillStyle = "#868e96";
+    ctx.font = "14px system-ui, sans-serif";
+    ctx.textAlign = "center";
+    ctx.fillText(text, c.width / dpr / 2, c.height / dpr / 2);
+    ctx.textAlign = "start";
+    c.dataset.waiting = text;
+    this.waitSize = [c.width, c.height];
+  }
+
   #plot() {
     if (!this.result) return;
-    if (!plotlyReady()) { window.addEventListener("load", () => this.#plot(), { once: true }); return; }
+    if (!plotlyReady()) { // plotly is loaded once the motion is on screen (lazy.js)
+      loadPlotly().then(() => this.#plot(), () => {});
+      return;
+    }
     const s = this.settings;
     plotRun({ a: this.result, b: this.resultB, labels: [s.method, s.methodB], spec: this.spec,
       phase: $("phase-q").value, lecture: this.lecture.on });
@@ -181,8 +316,8 @@ class SceneView {
     $("restart").addEventListener("click", () => { this.time = 0; this.#setPlaying(true); });
     $("speed").addEventListener("change", () => { this.speed = Number($("speed").value); });
     $("scrub").addEventListener("input", () => {
-      if (!this.result) return;
-      const t = this.result.t;
+      if (!this.shown) return;
+      const t = this.shown.t;
       this.time = (Number($("scrub").value) / 1000) * t[t.length - 1];
       this.#setPlaying(false);
     });
@@ -190,18 +325,24 @@ class SceneView {
 
   #setPlaying(on) {
     this.playing = on;
-    $("play").textContent = on ? "❚❚ Pause" : "▶ Play";
-    $("play").setAttribute("aria-pressed", String(on));
+    this.#syncPlay();
     if (!on) this.fbd(true);
   }
 
+  /** 'Pause' only while something moves on the canvas: before the first run it says so. */
+  #syncPlay() {
+    const ready = Boolean(this.shown);
+    $("play").textContent = !ready ? "… computing" : this.playing ? "❚❚ Pause" : "▶ Play";
+    $("play").setAttribute("aria-pressed", String(this.playing && ready));
+  }
+
   togglePlay() {
-    const r = this.result;
+    const r = this.shown;
     if (!this.playing && r && stopOf(r) && this.time >= r.t[r.t.length - 1]) this.time = 0; // replay
     this.#setPlaying(!this.playing);
   }
 
-  frameIndex(r = this.result) {
+  frameIndex(r = this.shown) {
     const step = r.t.length > 1 ? r.t[1] - r.t[0] : 1;
     return Math.min(r.t.length - 1, Math.round(this.time / step));
   }
@@ -211,19 +352,28 @@ class SceneView {
     const tick = (now) => {
       const dt = Math.min(0.1, (now - last) / 1000);
       last = now;
-      const r = this.result;
+      if (this.previewDue && this.live) this.#computePreview();
+      const r = this.shown;
       if (r && r.t.length) {
         const end = r.t[r.t.length - 1];
-        if (this.playing) this.time += dt * this.speed;
+        const held = this.drag.active;
+        if (this.playing && !held) this.time += dt * this.speed;
+        if (held) this.time = 0;
         if (this.time >= end && stopOf(r)) { // a stop ended the run: hold its last frame
           this.time = end;
           if (this.playing) { this.#setPlaying(false); $("scrub").value = 1000; }
         } else if (this.time > end) this.time = end > 0 ? this.time % end : 0;
         this.stageA.draw(this.frameIndex());
+        this.drag.overlay();
         if (this.resultB) this.stageB.draw(this.frameIndex(this.resultB));
         $("clock").textContent = `t = ${this.time.toFixed(2)} s`;
         if (this.playing) $("scrub").value = end > 0 ? Math.round((1000 * this.time) / end) : 0;
         if (this.playing) this.fbd();
+      } else {
+        const c = $("canvas"); // the message again whenever the canvas was sized (which clears it)
+        if (c.dataset.waiting && (c.width !== this.waitSize?.[0] || c.height !== this.waitSize?.[1])) {
+          this.#waiting(c.dataset.waiting);
+        }
       }
       requestAnimationFrame(tick);
     };
@@ -236,6 +386,7 @@ class SceneView {
     if (!now && t - (this.fbdAt || 0) < 150) return;
     this.fbdAt = t;
     if (!this.result || !$("fbd-svg")) return;
+    if (this.shown !== this.result) return; // the diagram is of the server's run, not a preview
     const placed = this.derivation?.steps?.find((s) => s.id === "fbd")?.data;
     const kinds = drawFBD($("fbd-svg"), this.spec, this.result, this.params, this.frameIndex(),
       { yaw: this.stageA.yaw, pitch: this.stageA.pitch }, placed);
@@ -248,7 +399,7 @@ class SceneView {
     delete steps.dataset.typeset;
     steps.innerHTML = '<li class="muted">Deriving the equations of motion…</li>';
     try {
-      this.derivation = given || await postJSON("/api/v1/derive", this.target());
+      this.derivation = given ? await given : await postJSON("/api/v1/derive", this.target());
     } catch (err) {
       steps.replaceChildren(Object.assign(document.createElement("li"), { className: "errors", textContent: err.message }));
       return;
@@ -275,8 +426,23 @@ class SceneView {
       setControl(`${q}_dot`, 0);
     });
     this.time = 0;
+    this.changes++;
+    this.preview();
     this.schedule(0);
   }
+}
+
+/** The line under the animation that says what it shows: a live preview or the server's run. */
+function liveBadge() {
+  let b = $("live-badge");
+  if (b) return b;
+  b = Object.assign(document.createElement("p"), { id: "live-badge", hidden: true });
+  b.setAttribute("role", "status");
+  Object.assign(b.style, { margin: "0.3rem 0", padding: "0.15rem 0.5rem", border: "1px solid transparent",
+    borderRadius: "4px", fontSize: "0.85rem" });
+  const views = document.querySelector(".stage-views");
+  views.after(b);
+  return b;
 }
 
 /** `stats.stop` of a run a declared stop condition ended: {name, t, message}. */

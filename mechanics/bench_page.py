@@ -1,0 +1,199 @@
+"""``python -m mechanics.bench_page``: how fast a scene page shows its derivation and a moving
+animation, and how many bytes it transfers, first visit and repeat (issue 13, item 1).
+
+Starts the app on a free loopback port (or measures ``--url``), warms the server (every scene's
+page asked for once, so derivations, compiled equations and live modules are in memory: "a warm
+server"), then opens each scene in a fresh browser context ("a cold browser": empty cache) and
+records, from navigation start:
+
+- derivation: the steps are on the page (their text; MathJax may still be typesetting);
+- typeset: MathJax has rendered them;
+- moving: the canvas has drawn two different frames of a run (a live preview or the server's);
+- server run: the server's run is on the canvas;
+- first visit: bytes transferred (compressed, headers included) until the page settled and its
+  plots were drawn; repeat: the same page opened again in the same context.
+
+Needs Playwright and Debian's chromium (as the browser tests do). The numbers depend on the
+machine: on a shared 2-core box, run it alone.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+
+CHROMIUM = "/usr/bin/chromium"
+ROOT = Path(__file__).resolve().parent.parent
+
+#: Recorded in the page from its first script on: when each milestone was first seen.
+PROBE = """
+(() => {
+  const seen = {};
+  window.__bench = seen;
+  let frame = null;
+  const mark = (k) => { if (!(k in seen)) seen[k] = performance.now(); };
+  const tick = () => {
+    const steps = document.querySelector("#steps li.step");
+    if (steps) mark("derivation");
+    const list = document.querySelector("#steps");
+    if (list && list.dataset.typeset === "1") mark("typeset");
+    const c = document.querySelector("#canvas");
+    if (c && c.dataset.frame !== undefined) {
+      if (frame !== null && c.dataset.frame !== frame) mark("moving");
+      frame = c.dataset.frame;
+    }
+    if (c && c.dataset.lastQ) mark("server_run");
+    if (document.querySelector("#plot-q .main-svg")) mark("plots");
+    const play = document.querySelector("#play");
+    if (play && /Pause/.test(play.textContent) && c && !c.dataset.source && !c.dataset.waiting) {
+      seen.blank_while_pause = (seen.blank_while_pause || 0) + 1;
+    }
+    requestAnimationFrame(tick);
+  };
+  requestAnimationFrame(tick);
+})();
+"""
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@contextlib.contextmanager
+def _server() -> Iterator[str]:
+    port = _free_port()
+    env = {**os.environ}
+    env.setdefault("LAGRANGE_LAB_CACHE", tempfile.mkdtemp(prefix="bench-page-"))
+    cmd = [sys.executable, "-m", "uvicorn", "app.main:app", "--port", str(port)]
+    proc = subprocess.Popen([*cmd, "--log-level", "warning"], cwd=ROOT, env=env)
+    url = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 120
+        while True:
+            try:
+                urllib.request.urlopen(f"{url}/healthz", timeout=1)
+                break
+            except OSError:
+                if time.monotonic() > deadline or proc.poll() is not None:
+                    raise RuntimeError("the server did not start") from None
+                time.sleep(0.2)
+        yield url
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+def _settle(page, timeout: float = 120_000) -> None:
+    page.wait_for_function(
+        "() => (document.documentElement.dataset.pending || '0') === '0'"
+        " && window.__bench && 'server_run' in window.__bench && 'typeset' in window.__bench"
+        " && 'plots' in window.__bench",
+        timeout=timeout,
+    )
+    page.wait_for_timeout(300)  # late resources (fonts MathJax asks for)
+
+
+def _visit(context, url: str) -> tuple[dict, int, int]:
+    """One navigation: the milestones (ms) and the bytes transferred, and the request count."""
+    page = context.new_page()
+    cdp = context.new_cdp_session(page)
+    cdp.send("Network.enable")
+    sizes: dict[str, int] = {}
+    cdp.on(
+        "Network.loadingFinished",
+        lambda e: sizes.__setitem__(e["requestId"], e["encodedDataLength"]),
+    )
+    page.goto(url)
+    _settle(page)
+    marks = page.evaluate("() => window.__bench")
+    page.close()
+    return marks, sum(sizes.values()), len(sizes)
+
+
+def measure(url: str, scenes: list[str]) -> list[dict]:
+    from playwright.sync_api import sync_playwright
+
+    rows = []
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=["--no-sandbox"])
+        try:
+            for scene in scenes:  # warm the server: what the page asks for, once
+                ctx = browser.new_context(bypass_csp=True)
+                ctx.add_init_script(PROBE)
+                _visit(ctx, f"{url}/scenes/{scene}")
+                ctx.close()
+            for scene in scenes:
+                ctx = browser.new_context(viewport={"width": 1400, "height": 900}, bypass_csp=True)
+                ctx.add_init_script(PROBE)
+                first, first_bytes, first_n = _visit(ctx, f"{url}/scenes/{scene}")
+                _, repeat_bytes, repeat_n = _visit(ctx, f"{url}/scenes/{scene}")
+                ctx.close()
+                rows.append(
+                    {
+                        "scene": scene,
+                        **{
+                            k: first.get(k)
+                            for k in ("derivation", "typeset", "moving", "server_run")
+                        },
+                        "blank_while_pause": first.get("blank_while_pause", 0),
+                        "first_kB": first_bytes / 1000,
+                        "first_requests": first_n,
+                        "repeat_kB": repeat_bytes / 1000,
+                        "repeat_requests": repeat_n,
+                    }
+                )
+        finally:
+            browser.close()
+    return rows
+
+
+def table(rows: list[dict]) -> str:
+    head = (
+        "| scene | derivation (ms) | typeset (ms) | moving (ms) | server run (ms) | "
+        "first visit (kB, requests) | repeat (kB, requests) |"
+    )
+    lines = [head, "|" + "---|" * 7]
+
+    def ms(v):
+        return "–" if v is None else f"{v:.0f}"
+
+    for r in rows:
+        lines.append(
+            f"| {r['scene']} | {ms(r['derivation'])} | {ms(r['typeset'])} | {ms(r['moving'])} | "
+            f"{ms(r['server_run'])} | {r['first_kB']:.0f} ({r['first_requests']}) | "
+            f"{r['repeat_kB']:.1f} ({r['repeat_requests']}) |"
+        )
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--url", help="measure a running server instead of starting one")
+    parser.add_argument("--scenes", help="comma-separated scene ids (default: every scene)")
+    args = parser.parse_args(argv)
+    from mechanics.scenes import scene_ids
+
+    scenes = args.scenes.split(",") if args.scenes else scene_ids()
+    if args.url:
+        print(table(measure(args.url.rstrip("/"), scenes)))
+        return
+    with _server() as url:
+        print(table(measure(url, scenes)))
+
+
+if __name__ == "__main__":
+    main()

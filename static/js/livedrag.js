@@ -1,0 +1,176 @@
+// Dragging a body on the canvas to set where the motion starts (and, with Shift held or the
+// "drag sets velocity" toggle, how fast it starts). The pointer is mapped to world coordinates by
+// inverting the stage's view; the coordinates that put the dragged body there come from the scene's
+// own position functions (live.js: damped Gauss–Newton), so a double pendulum's lower bob moves
+// both angles and a bead stays on its hoop. Nothing is asked of the server while dragging: the
+// live preview redraws each animation frame; the server's run is asked for on release.
+// Planar scenes only: in a 3-D view a drag turns the camera (draw.js).
+import { unproject } from "./live.js";
+
+const PICK_PX = 30; // how near the pointer must be to a body to grab it
+const VELOCITY_SECONDS = 1; // the arrow's tip is where the body would be after 1 s at that speed
+
+const $ = (id) => document.getElementById(id);
+
+export class BodyDrag {
+  constructor(sceneView) {
+    this.sv = sceneView;
+    this.canvas = $("canvas");
+    this.drag = null;
+    this.velocityMode = false;
+    this.canvas.addEventListener("pointerdown", (e) => this.#down(e));
+    this.canvas.addEventListener("pointermove", (e) => this.#hover(e));
+    this.#toggle();
+  }
+
+  get active() {
+    return this.drag !== null;
+  }
+
+  /** The button beside the playback controls that makes a drag set the velocity instead. */
+  #toggle() {
+    const bar = document.querySelector(".playback");
+    if (!bar || $("drag-mode")) return;
+    const b = Object.assign(document.createElement("button"), { id: "drag-mode", type: "button" });
+    b.title = "drag a body on the canvas to set where it starts; Shift-drag (or this toggle) sets its velocity";
+    const sync = () => {
+      b.textContent = this.velocityMode ? "drag sets: velocity" : "drag sets: position";
+      b.setAttribute("aria-pressed", String(this.velocityMode));
+    };
+    b.addEventListener("click", () => { this.velocityMode = !this.velocityMode; sync(); });
+    sync();
+    bar.append(b);
+  }
+
+  #usable() {
+    const { live, shown, stageA } = this.sv;
+    return live && shown && stageA.geom && !stageA.geom.is3D && stageA.view;
+  }
+
+  /** Pointer position in the canvas's CSS pixels (the view's units). */
+  #local(e) {
+    const r = this.canvas.getBoundingClientRect();
+    const st = this.sv.stageA;
+    return [(e.clientX - r.left) * (st.cssW / r.width), (e.clientY - r.top) * (st.cssH / r.height)];
+  }
+
+  /** The movable body drawn nearest the pointer (within PICK_PX), or null. */
+  #pick(at) {
+    const { stageA, spec, live } = this.sv;
+    const i = stageA.frame;
+    let best = null, bestD = PICK_PX;
+    for (const b of spec.bodies || []) {
+      if (!live.meta.points.includes(b.name) || stageA.geom.fixed.has(b.name)) continue;
+      const s = stageA.view.project(stageA.geom.at(b.name, i));
+      const d = Math.hypot(s[0] - at[0], s[1] - at[1]);
+      if (d < bestD) { best = b.name; bestD = d; }
+    }
+    return best;
+  }
+
+  #hover(e) {
+    if (this.drag || !this.#usable()) return;
+    this.canvas.style.cursor = this.#pick(this.#local(e)) ? "grab" : "";
+  }
+
+  #down(e) {
+    if (!this.#usable() || e.button > 0) return;
+    const at = this.#local(e);
+    const body = this.#pick(at);
+    if (!body) return;
+    e.preventDefault();
+    e.stopImmediatePropagation();
+    const sv = this.sv;
+    const live = sv.live;
+    this.canvas.setPointerCapture?.(e.pointerId);
+    this.canvas.style.cursor = "grabbing";
+    this.drag = {
+      body, velocity: this.velocityMode || e.shiftKey, at, view: sv.stageA.view,
+      y: live.state(sv.initial), p: live.paramVector(sv.params),
+    };
+    this.wasPlaying = sv.playing;
+    sv.time = 0;
+    const move = (m) => { this.drag.at = this.#local(m); this.#apply(); };
+    const up = () => {
+      this.canvas.removeEventListener("pointermove", move);
+      this.canvas.removeEventListener("pointerup", up);
+      this.canvas.removeEventListener("pointercancel", up);
+      this.canvas.style.cursor = "";
+      this.drag = null;
+      sv.time = 0;
+      sv.schedule(0); // the server's run of the new start
+    };
+    this.canvas.addEventListener("pointermove", move);
+    this.canvas.addEventListener("pointerup", up);
+    this.canvas.addEventListener("pointercancel", up);
+    this.#apply();
+  }
+
+  /** The state the pointer asks for, into the controls and the preview. */
+  #apply() {
+    const d = this.drag;
+    const live = this.sv.live;
+    const here = live.places(d.y, d.p)[d.body];
+    const target = unproject(d.view, d.at[0], d.at[1], here[2]);
+    if (d.velocity) {
+      const v = [0, 1].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS).concat(0);
+      d.y = live.velocityFor(d.body, v, d.y, d.p);
+    } else {
+      d.y = live.reach(d.body, target, d.y, d.p);
+      for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
+    }
+    const values = {};
+    live.meta.coordinates.forEach((q, j) => {
+      values[q] = d.y[j];
+      values[`${q}_dot`] = d.y[live.n + j];
+    });
+    this.sv.setInitial(values);
+  }
+
+  /** Keep the view the drag started in (a refit would move the world under the pointer). */
+  freeze() {
+    if (!this.drag) return;
+    const st = this.sv.stageA;
+    st.view = this.drag.view;
+    st.follow = false;
+  }
+
+  /** Drawn over the stage each frame: the velocity arrow while one is dragged, and (for tests and
+   * tools) where each point is on screen while the motion stands still. */
+  overlay() {
+    const st = this.sv.stageA;
+    if (!st.geom || !st.view) return;
+    if (this.drag || !this.sv.playing) {
+      const pts = {};
+      for (const name of Object.keys(st.geom.P)) {
+        const s = st.view.project(st.geom.at(name, st.frame));
+        pts[name] = [Number(s[0].toFixed(2)), Number(s[1].toFixed(2))];
+      }
+      this.canvas.dataset.screen = JSON.stringify(pts);
+    }
+    const d = this.drag;
+    if (!d || !d.velocity) return;
+    const from = st.view.project(st.geom.at(d.body, 0));
+    const ctx = st.ctx;
+    const [x0, y0] = from, [x1, y1] = d.at;
+    const len = Math.hypot(x1 - x0, y1 - y0);
+    if (len < 2) return;
+    const ux = (x1 - x0) / len, uy = (y1 - y0) / len;
+    ctx.save();
+    ctx.strokeStyle = ctx.fillStyle = "#d9480f";
+    ctx.lineWidth = 2.5;
+    ctx.beginPath();
+    ctx.moveTo(x0, y0);
+    ctx.lineTo(x1 - 8 * ux, y1 - 8 * uy);
+    ctx.stroke();
+    ctx.beginPath();
+    ctx.moveTo(x1, y1);
+    ctx.lineTo(x1 - 11 * ux - 5 * uy, y1 - 11 * uy + 5 * ux);
+    ctx.lineTo(x1 - 11 * ux + 5 * uy, y1 - 11 * uy - 5 * ux);
+    ctx.closePath();
+    ctx.fill();
+    ctx.font = "12px system-ui, sans-serif";
+    ctx.fillText("v (tip: where it is after 1 s)", x1 + 6, y1 - 6);
+    ctx.restore();
+  }
+}
