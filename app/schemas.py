@@ -334,6 +334,81 @@ class CheckResponse(BaseModel):
     expected_latex: str | None = Field(default=None, description="Only with reveal: true.")
 
 
+class PredictRequest(CheckRequest):
+    """A student's answer, to be integrated beside the true motion from the same state."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {
+                    "scene_id": "simple_pendulum",
+                    "quantity": "eom",
+                    "coordinate": "theta",
+                    "answer": "theta'' - g/l sin(theta) = 0",
+                },
+                {"scene_id": "double_pendulum", "quantity": "T", "answer": "...", "t_end": 3},
+            ]
+        },
+    )
+
+    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
+    initial: dict[str, float] = Field(
+        default={}, description="Overrides of the initial state (q and q_dot by name)."
+    )
+    t_end: float = Field(default=5.0, gt=0, le=10, description="Seconds to integrate (≤ 10).")
+
+
+class PredictedRun(BaseModel):
+    """One model's motion: sampled at 60 per second (≤ 601 samples) until t_end or a stop."""
+
+    t: list[float]
+    q: dict[str, list[float | None]]
+    q_dot: dict[str, list[float | None]]
+    energy: list[float | None] = Field(
+        description="The TRUE energy E = T + V (the derivation's) along this run."
+    )
+    positions: dict[str, dict[str, list[float | None]]] = Field(
+        description="x, y, z in N of every body and point, as in /simulate."
+    )
+    frames: dict[str, list[list[float | None]]] = Field(
+        description="Per sample, a frame's x, y, z axes in N (9 numbers), as in /simulate."
+    )
+    reached: float = Field(description="How far in time the stepping got.")
+    blew_up_at: float | None = Field(
+        default=None,
+        description="When the run stopped because it blew up (|q| or |q̇| > 1e6, not finite, "
+        "or q̈ undetermined): a result, not an error.",
+    )
+    stopped_because: str | None = Field(default=None, description="Why it stopped early.")
+
+
+class PredictResponse(BaseModel):
+    """What the answer predicts: its motion beside the true one, when they part, and the
+    energy the student's model gains or loses, measured with the true E."""
+
+    correct: bool
+    feedback: list[str] = Field(description="The check's feedback (math as $…$).")
+    answer_latex: str
+    true: PredictedRun = Field(description="The derivation's motion.")
+    student: PredictedRun = Field(description="The answer's motion, from the same state.")
+    parted_at: float | None = Field(
+        description="When the two motions first part visibly (parting_rule); null if never."
+    )
+    parting_rule: str = Field(description="What 'part visibly' means for this scene.")
+    energy_change: float = Field(
+        description="ΔE of the student's run minus ΔE of the true run (both with the true E) "
+        "up to energy_until, over energy_scale: > 0 the answer creates energy, < 0 destroys it."
+    )
+    energy_change_max: float = Field(description="The largest |difference| along the way.")
+    energy_scale: float = Field(
+        description="The motion's energy: the true run's largest kinetic energy (else |E(0)|)."
+    )
+    energy_until: float = Field(description="The last time both energies are known.")
+    blamed: str | None = Field(description="The feedback line that names the error, if any.")
+    summary: str = Field(description="One sentence for the student (math as $…$).")
+
+
 class EquilibriaRequest(DeriveRequest):
     """Find the equilibria of a scene at the given parameter values."""
 

@@ -323,7 +323,7 @@ class _Builder:
             if op is ast.Pow:
                 value = self.finite(combine(value, *run), last) if run else value
                 run = []
-                self.check_power(value, right, op_node)
+                self.check_power(value, right, op_node.right)  # point at the exponent
                 value = self.finite(value**right, op_node)
                 continue
             kind = sp.Add if op in (ast.Add, ast.Sub) else sp.Mul

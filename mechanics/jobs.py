@@ -20,6 +20,7 @@ from mechanics.check import check
 from mechanics.derive import Derivation, derivation_of_scene, derivation_of_spec, spec_text
 from mechanics.equilibria import equilibria
 from mechanics.newton import newton_json
+from mechanics.predict import predict
 from mechanics.simulate import SimulationRequest, simulate
 
 
@@ -54,6 +55,28 @@ def answer_check(
 ) -> dict[str, Any]:
     """POST /check: a student's answer judged against the scene's derivation."""
     return check(derivation_of(scene_id, key), quantity, answer, coordinate).to_json(reveal)
+
+
+def answer_predict(
+    scene_id: str | None,
+    key: str | None,
+    quantity: str,
+    answer: str,
+    coordinate: str | None,
+    parameters: dict[str, float],
+    initial: dict[str, float],
+    t_end: float,
+) -> dict[str, Any]:
+    """POST /check/predict: the answer's motion integrated beside the true one."""
+    return predict(
+        derivation_of(scene_id, key),
+        quantity,
+        answer,
+        coordinate,
+        parameters=parameters,
+        initial=initial,
+        t_end=t_end,
+    )
 
 
 def equilibria_json(

@@ -1,0 +1,430 @@
+"""What a student's answer predicts: its motion beside the true one, from the same initial state.
+
+A wrong equation of motion is easier to believe wrong when it is seen to move wrong. From the
+answer (read by the same whitelist parser as the check) the student's model is built as a set of
+equations linear in q̈, one per coordinate:
+
+- ``eom``: the student's equation for coordinate j, the derived ones for the others;
+- ``accel``: q̈_j − (the student's q̈_j) = 0, the derived equations for the others;
+- ``T``, ``V``, ``L``: Lagrange's equations of L' = T' − V, T − V' or L' (notes eq. 31), with the
+  scene's own non-conservative Q;
+- ``Q``: the derived left-hand sides with the student's Q_j.
+
+Both models, the true one through the very same code, are integrated with DOP853 (rtol 1e-9)
+from the scene's initial state for a few seconds under a wall-time and step cap. The report:
+both trajectories (q, q̇, the positions and frame axes for drawing), the time they part visibly
+(a stated rule), and the energy of each run measured with the TRUE E(q, q̇) = T + V, so an answer
+that creates or destroys energy says how much.
+
+An answer that cannot be integrated (no q̈ in it, q̈ not linear, its q̈ undetermined at the
+initial state) is refused as an ExprError on ``answer``; one that blows up during the run is a
+result (``student.blew_up_at``), not an error.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import sympy as sp
+from scipy.integrate import DOP853
+
+from mechanics.check import check, expected_quantity, read_answer
+from mechanics.derive import Derivation
+from mechanics.expr import ExprError, to_latex
+from mechanics.model import T as t
+from mechanics.numeric import _MATH, _NUMPY, _args, _plain
+from mechanics.spec import SpecError
+from mechanics.steps import partial
+
+PREDICTED = ("T", "V", "L", "Q", "eom", "accel")
+T_END, MAX_T_END = 5.0, 10.0
+SAMPLES_PER_SECOND = 60
+MAX_SAMPLES = 601
+MAX_STEPS = 20_000
+RUN_SECONDS = 2.0  # wall time of one run; the pool's budget bounds the whole job
+RTOL = ATOL = 1e-9
+#: |q| or |q̇| past this is a blow-up: no teaching scene moves 10⁶ rad or m, or at 10⁶ per s
+BLOW_UP = 1e6
+#: The runs have parted visibly when some body is this fraction of the scene's size away from
+#: where it truly is (scenes without moving bodies: a coordinate off by PART_COORDINATE).
+PART_FRACTION = 0.02
+PART_COORDINATE = 0.05
+
+
+_SINGULAR = "its accelerations are not determined there (their coefficients vanish)"
+_INFINITE = "its accelerations are not finite"
+
+
+class _Stop(Exception):
+    """The right-hand side cannot go on: the student's q̈ is singular or not finite here."""
+
+    def __init__(self, why: str) -> None:
+        super().__init__(why)
+        self.why = why
+
+
+@dataclass
+class Run:
+    t: np.ndarray
+    y: np.ndarray  # samples × 2n: q then q̇
+    reached: float  # how far the stepping got
+    blew_up_at: float | None = None
+    why: str = ""  # why it stopped early, in words
+
+
+def equations(d: Derivation, quantity: str, given: sp.Expr, j: int | None) -> list[sp.Expr]:
+    """The student's model as expressions that vanish along its motion, one per coordinate."""
+    m, w = d.model, d.work
+    true = [w.eom_lhs[k] - w.Q[k] for k in range(len(m.q))]
+    if quantity == "eom":
+        return [given if k == j else e for k, e in enumerate(true)]
+    if quantity == "accel":
+        return [m.qdd[k] - given if k == j else e for k, e in enumerate(true)]
+    if quantity == "Q":
+        return [w.eom_lhs[k] - (given if k == j else w.Q[k]) for k in range(len(m.q))]
+    lagrangian = {"T": lambda: given - w.V, "V": lambda: w.T - given, "L": lambda: given}[
+        quantity
+    ]()
+    return [lagrange(d, lagrangian, k) - w.Q[k] for k in range(len(m.q))]
+
+
+def lagrange(d: Derivation, lagrangian: sp.Expr, k: int) -> sp.Expr:
+    """d/dt ∂L/∂q̇_k − ∂L/∂q_k, the total time derivative taken by the chain rule."""
+    m = d.model
+    p = partial(lagrangian, m.qd[k], m)
+    rate = partial(p, t, m)
+    for q, qd, qdd in zip(m.q, m.qd, m.qdd, strict=True):
+        rate += partial(p, q, m) * qd + partial(p, qd, m) * qdd
+    return rate - partial(lagrangian, m.q[k], m)
+
+
+def linear_system(d: Derivation, rows: list[sp.Expr]) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """rows = A q̈ − b: A (row-major) and b; ExprError when q̈ is not in them linearly."""
+    m = d.model
+    a, b = [], []
+    for row in rows:
+        coefficients = [partial(row, qdd, m) for qdd in m.qdd]
+        for c in coefficients:
+            if any(partial(c, qdd, m) != 0 for qdd in m.qdd):
+                raise ExprError(
+                    "the accelerations appear non-linearly (q̈ squared, or inside a function): "
+                    "such an equation does not give one motion to draw",
+                    field="answer",
+                )
+        a += coefficients
+        b.append(-row.xreplace(dict.fromkeys(m.qdd, sp.S.Zero)))
+    return a, b
+
+
+def compile_model(d: Derivation, rows: list[sp.Expr]) -> Any:
+    """(t, q…, q̇…, params…) -> [A flat…, b…] as scalar math code (lambdify, cse)."""
+    args, subs = _args(d)
+    a, b = linear_system(d, rows)
+    exprs = [_plain(e, subs) for e in (*a, *b)]
+    allowed = set(args)
+    stray = set().union(*(e.free_symbols for e in exprs)) - allowed
+    if stray or any(e.has(sp.Derivative) for e in exprs):
+        names = ", ".join(sorted(str(s) for s in stray)) or "a derivative"
+        raise ExprError(f"uses {names}, which is not a variable of this scene", field="answer")
+    return sp.lambdify(args, exprs, modules=_MATH, cse=True)
+
+
+def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: float) -> Run:
+    """DOP853 step by step, sampled on a uniform grid; stops at a blow-up, a singular q̈, the
+    step cap or the wall-time cap, keeping what it has."""
+    samples = min(MAX_SAMPLES, int(t_end * SAMPLES_PER_SECOND) + 1)
+    grid = np.linspace(0.0, t_end, samples)
+
+    def rhs(time_: float, y: np.ndarray) -> np.ndarray:
+        state = y.tolist()
+        try:
+            values = fn(time_, *state, *params)
+        except OverflowError:
+            raise _Stop("its numbers overflow double precision") from None
+        except ZeroDivisionError:
+            raise _Stop("it divides by zero") from None
+        except ValueError:
+            raise _Stop("it leaves the domain of a function (a root of a negative, …)") from None
+        if n == 1:  # the common case, without numpy's linear algebra per call
+            a, b = values
+            if not (math.isfinite(a) and math.isfinite(b)) or abs(a) <= 1e-300:
+                raise _Stop(_SINGULAR if math.isfinite(a) and math.isfinite(b) else _INFINITE)
+            return np.array([state[1], b / a])
+        a = np.array(values[: n * n], dtype=float).reshape(n, n)
+        b = np.array(values[n * n :], dtype=float)
+        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+            raise _Stop(_INFINITE)
+        try:
+            qdd = np.linalg.solve(a, b)
+        except np.linalg.LinAlgError:
+            raise _Stop(_SINGULAR) from None
+        return np.concatenate([y[n:], qdd])
+
+    out = np.empty((samples, 2 * n))
+    out[0] = y0
+    rhs(0.0, np.asarray(y0, dtype=float))  # a model singular at the start is refused by the caller
+    solver = DOP853(rhs, 0.0, np.asarray(y0, dtype=float), t_end, rtol=RTOL, atol=ATOL)
+    k, steps, deadline = 1, 0, time.monotonic() + RUN_SECONDS
+    run = Run(grid, out, 0.0)
+    while solver.status == "running":
+        try:
+            solver.step()
+        except _Stop as stop:
+            run.blew_up_at, run.why = float(solver.t), stop.why
+            break
+        if solver.status == "failed":
+            run.blew_up_at, run.why = float(solver.t), "its step size fell to nothing"
+            break
+        if not np.all(np.isfinite(solver.y)) or np.max(np.abs(solver.y)) > BLOW_UP:
+            run.blew_up_at, run.why = float(solver.t), f"|q| or |q̇| passed {BLOW_UP:g}"
+        dense = solver.dense_output()
+        while k < samples and grid[k] <= solver.t:
+            out[k] = dense(grid[k])
+            k += 1
+        run.reached = float(solver.t)
+        if run.blew_up_at is not None:
+            break
+        steps += 1
+        if steps >= MAX_STEPS or time.monotonic() > deadline:
+            run.why = "it needs too many steps (it is stiff or blowing up)"
+            break
+    finite = np.all(np.isfinite(out[:k]), axis=1)
+    k = int(np.argmin(finite)) if not finite.all() else k
+    run.t, run.y = grid[:k], out[:k]
+    return run
+
+
+def initial_state(
+    d: Derivation, parameters: dict[str, float], initial: dict[str, float]
+) -> tuple[list[float], list[float]]:
+    """The scene's parameters and initial state with the request's overrides (checked names)."""
+    spec = d.model.spec
+    errors = []
+    for where, given, known in (
+        ("parameters", parameters, set(spec.parameters)),
+        ("initial", initial, set(spec.coordinates) | {f"{q}_dot" for q in spec.coordinates}),
+    ):
+        for name, value in given.items():
+            if name not in known:
+                errors.append({"field": f"{where}.{name}", "message": f"unknown name '{name}'"})
+            elif not math.isfinite(value):
+                errors.append({"field": f"{where}.{name}", "message": "must be a finite number"})
+    if errors:
+        raise SpecError(errors)
+    values = {**spec.parameters, **parameters}
+    state = {**spec.initial, **initial}
+    y0 = [state.get(q, 0.0) for q in spec.coordinates]
+    y0 += [state.get(f"{q}_dot", 0.0) for q in spec.coordinates]
+    return [values[k] for k in spec.parameters], y0
+
+
+class _Drawing:
+    """The true E = T + V, positions and frame axes as numpy functions of a trajectory."""
+
+    def __init__(self, d: Derivation) -> None:
+        m, w = d.model, d.work
+        args, subs = _args(d)
+
+        def vector(exprs: list) -> Any:
+            return sp.lambdify(args, [_plain(e, subs) for e in exprs], modules=_NUMPY, cse=True)
+
+        axes = (m.N.x, m.N.y, m.N.z)
+        self.n = len(m.q)
+        self.energy = vector([w.T, w.V])
+        self.places = {name: vector([r.dot(u) for u in axes]) for name, r in m.positions.items()}
+        self.frames = {
+            name: vector([getattr(f.frame, a).dot(u) for a in "xyz" for u in axes])
+            for name, f in m.frames.items()
+        }
+
+    def at(self, fn: Any, run: Run, params: list[float]) -> list[np.ndarray]:
+        n, times = self.n, run.t
+        with np.errstate(all="ignore"):
+            out = fn(times, *run.y[:, :n].T, *run.y[:, n:].T, *(np.float64(p) for p in params))
+        return [np.broadcast_to(np.asarray(v, dtype=float), times.shape) for v in out]
+
+    def total(self, run: Run, params: list[float]) -> np.ndarray:
+        """The true E = T + V along a run."""
+        kinetic, potential = self.at(self.energy, run, params)
+        return kinetic + potential
+
+    def json(self, run: Run, params: list[float], names: list[str]) -> dict[str, Any]:
+        n = self.n
+        places = {k: self.at(f, run, params) for k, f in self.places.items()}
+        frames = {k: np.stack(self.at(f, run, params), axis=1) for k, f in self.frames.items()}
+        return {
+            "t": _floats(run.t),
+            "q": {q: _floats(run.y[:, i]) for i, q in enumerate(names)},
+            "q_dot": {q: _floats(run.y[:, n + i]) for i, q in enumerate(names)},
+            "energy": _floats(self.total(run, params)),
+            "positions": {
+                k: dict(zip("xyz", map(_floats, v), strict=True)) for k, v in places.items()
+            },
+            "frames": {k: [_floats(row) for row in v] for k, v in frames.items()},
+            "reached": run.reached,
+            "blew_up_at": run.blew_up_at,
+            "stopped_because": run.why or None,
+        }
+
+
+def _floats(values: np.ndarray) -> list[float | None]:
+    """JSON numbers (9 significant digits: enough to check the run against another); None where
+    not finite."""
+    return [float(f"{v:.9g}") if math.isfinite(v) else None for v in np.asarray(values).tolist()]
+
+
+def parting(
+    drawing: _Drawing, true: Run, student: Run, params: list[float]
+) -> tuple[float | None, str]:
+    """When the student's motion is first visibly apart from the true one, and the rule used."""
+    k = min(len(true.t), len(student.t))
+    cut_true = Run(true.t[:k], true.y[:k], true.reached)
+    cut_student = Run(student.t[:k], student.y[:k], student.reached)
+    tracks = {name: np.stack(drawing.at(fn, true, params)) for name, fn in drawing.places.items()}
+    moving = [name for name, xyz in tracks.items() if np.ptp(xyz, axis=1).max() > 0]
+    if moving:
+        every = np.concatenate(list(tracks.values()), axis=1)
+        size = float(np.linalg.norm(every.max(axis=1) - every.min(axis=1))) or 1.0
+        gap = np.zeros(k)
+        for name in moving:
+            a = np.stack(drawing.at(drawing.places[name], cut_true, params))
+            b = np.stack(drawing.at(drawing.places[name], cut_student, params))
+            gap = np.maximum(gap, np.linalg.norm(a - b, axis=0))
+        apart = np.nonzero(~(gap <= PART_FRACTION * size))[0]
+        rule = (
+            f"a body more than {PART_FRACTION:.0%} of the scene's size ({size:.3g}) "
+            "from where it truly is"
+        )
+    else:
+        n = drawing.n
+        gap = np.max(np.abs(cut_true.y[:, :n] - cut_student.y[:, :n]), axis=1)
+        apart = np.nonzero(~(gap <= PART_COORDINATE))[0]
+        rule = f"a coordinate more than {PART_COORDINATE} (rad or m) from its true value"
+    if len(apart):
+        return float(true.t[apart[0]]), rule
+    if student.blew_up_at is not None:
+        return student.blew_up_at, rule
+    return None, rule
+
+
+def predict(
+    d: Derivation,
+    quantity: str,
+    answer: str,
+    coordinate: str | None = None,
+    *,
+    parameters: dict[str, float] | None = None,
+    initial: dict[str, float] | None = None,
+    t_end: float = T_END,
+) -> dict[str, Any]:
+    """Check the answer, then integrate its model beside the true one (see the module docstring).
+
+    Raises SpecError (bad quantity, coordinate, overrides) or ExprError (unparseable answer, or
+    one that gives no motion)."""
+    if quantity not in PREDICTED:
+        raise SpecError(
+            [{"field": "quantity", "message": f"a prediction needs one of {', '.join(PREDICTED)}"}]
+        )
+    if not (0 < t_end <= MAX_T_END):
+        raise SpecError([{"field": "t_end", "message": f"must be in (0, {MAX_T_END:g}] seconds"}])
+    verdict = check(d, quantity, answer, coordinate)
+    m = d.model
+    j = m.coordinate_names.index(coordinate) if quantity in ("Q", "eom", "accel") else None
+    given, _ = read_answer(d, quantity, answer, j)
+    params, y0 = initial_state(d, parameters or {}, initial or {})
+    n = len(m.q)
+    true_rows = [expected_quantity(d, "eom", k) for k in range(n)]
+    if quantity == "eom" and not any(given.has(a) for a in m.qdd):
+        raise ExprError(
+            f"your equation has no acceleration (${to_latex(m.qdd[j])}$ does not appear): it "
+            "gives no motion to integrate",
+            field="answer",
+        )
+    student_fn = compile_model(d, equations(d, quantity, given, j))
+    true_fn = compile_model(d, true_rows)
+    try:
+        true = integrate(true_fn, n, y0, params, t_end)
+    except _Stop as stop:
+        raise SpecError(
+            [
+                {
+                    "field": "initial",
+                    "message": f"the derived equations cannot start here: {stop.why}",
+                }
+            ]
+        ) from None
+    try:
+        student = integrate(student_fn, n, y0, params, t_end)
+    except _Stop as stop:
+        raise ExprError(
+            f"your answer gives no motion from the initial state: {stop.why}", field="answer"
+        ) from None
+    if student.blew_up_at is not None and student.reached == 0:
+        raise ExprError(f"your answer's motion blows up at once: {student.why}", field="answer")
+    drawing = _Drawing(d)
+    parted_at, rule = parting(drawing, true, student, params)
+    kinetic, potential = drawing.at(drawing.energy, true, params)
+    energy = energy_change(
+        student.t, kinetic + potential, drawing.total(student, params), float(np.max(kinetic))
+    )
+    blamed = next((f for f in verdict.feedback if not f.startswith(("Read as", "Correct"))), None)
+    return {
+        "correct": verdict.correct,
+        "feedback": verdict.feedback,
+        "answer_latex": verdict.answer_latex,
+        "true": drawing.json(true, params, m.coordinate_names),
+        "student": drawing.json(student, params, m.coordinate_names),
+        "parted_at": parted_at,
+        "parting_rule": rule,
+        **energy,
+        "blamed": blamed,
+        "summary": _summary(parted_at, student, energy, blamed),
+    }
+
+
+def energy_change(
+    times: np.ndarray, e_true: np.ndarray, e_student: np.ndarray, kinetic_max: float
+) -> dict[str, Any]:
+    """How much energy (the TRUE E = T + V) the student's run gains over the true run's, from
+    the start to the last time it reached, as a fraction of the motion's energy: the largest
+    kinetic energy of the true run (independent of V's datum), else |E(0)|, else 1."""
+    k = min(len(e_true), len(e_student))
+    drift = (e_student[:k] - e_student[0]) - (e_true[:k] - e_true[0])
+    finite = np.isfinite(drift)
+    last = k - 1 if finite.all() else max(0, int(np.argmin(finite)) - 1)
+    scale = kinetic_max if kinetic_max > 0 else abs(float(e_true[0])) or 1.0
+    return {
+        "energy_change": float(drift[last]) / scale,
+        "energy_change_max": float(np.max(np.abs(drift[: last + 1]))) / scale,
+        "energy_scale": scale,
+        "energy_until": float(times[last]),
+    }
+
+
+def _summary(
+    parted_at: float | None, student: Run, energy: dict[str, Any], blamed: str | None
+) -> str:
+    """One sentence a student reads first (math as $…$)."""
+    parts = []
+    if student.blew_up_at is not None:
+        parts.append(
+            f"your answer's motion blows up at t = {student.blew_up_at:.3g} s ({student.why})"
+        )
+    if parted_at is not None:
+        parts.append(f"it parts visibly from the true motion at t = {parted_at:.2f} s")
+    change = energy["energy_change"]
+    if abs(change) >= 1e-3:
+        verb = "creates" if change > 0 else "destroys"
+        parts.append(
+            f"measured with the true energy, your model {verb} {abs(change):.0%} of the motion's "
+            f"energy in {energy['energy_until']:.2f} s"
+        )
+    if not parts:
+        return "Your answer predicts the same motion as the derivation."
+    text = "; ".join(parts)
+    text = text[0].upper() + text[1:]
+    return f"{text}: {blamed[0].lower() + blamed[1:]}" if blamed else f"{text}."
