@@ -124,8 +124,8 @@ def _series(run: Mapping[str, Any], column: str) -> list[Any]:
 def trajectory_csv(
     run: Mapping[str, Any], units: Mapping[str, str], comments: Iterable[str] = ()
 ) -> str:
-    """The run as CSV: ``#`` comment lines (what was run, its stats: numpy.loadtxt and pandas'
-    ``comment="#"`` skip them), a header ``name [unit]``, one row per sample. Numbers are written
+    """The run as CSV: ``#`` comment lines (what was run, its stats: pandas' ``comment="#"``
+    skips them), a header ``name [unit]``, one row per sample. Numbers are written
     with ``repr`` (they read back as the same doubles); a missing value (null) as ``nan``."""
     columns = trajectory_columns(run, units)
     out = io.StringIO()
