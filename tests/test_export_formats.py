@@ -122,6 +122,24 @@ def test_trajectory_csv_matches_the_simulation_number_for_number():
     assert [float(v) for v in columns[5]] == run["energy"]["E"]
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("scene_id", scene_ids())
+def test_every_builtin_scenes_trajectory_csv_has_every_sample_and_column(scene_id):
+    query = "t_end=0.5&method=DOP853"
+    r = client.get(f"/api/v1/export/scenes/{scene_id}/trajectory.csv?{query}")
+    assert r.status_code == 200, r.text
+    rows = [line.split(",") for line in r.text.splitlines() if not line.startswith("#")]
+    coordinates = load_scene(scene_id)["coordinates"]
+    assert len(rows[0]) == 1 + 2 * len(coordinates) + 5
+    run = client.post(
+        "/api/v1/simulate", json={"scene_id": scene_id, "t_end": 0.5, "method": "DOP853"}
+    ).json()
+    assert len(rows) - 1 == len(run["t"])
+    for i, q in enumerate(coordinates):
+        assert rows[0][1 + i].split(" ")[0] == q
+        assert [float(row[1 + i]) for row in rows[1:]] == run["q"][q]
+
+
 def test_trajectory_json_of_a_posted_spec_carries_stats_and_units():
     spec = load_scene("simple_pendulum")
     spec["title"] = "My pendulum"

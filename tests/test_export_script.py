@@ -24,6 +24,7 @@ from fastapi.testclient import TestClient
 
 from app.main import app
 from mechanics.export_script import ScriptError, checked_expression
+from mechanics.scenes import scene_ids
 
 client = TestClient(app)
 
@@ -106,6 +107,26 @@ def test_script_reproduces_the_api_trajectory(body, fixed_tol, tmp_path):
             bound = fixed_tol * scale if fixed_tol else rtol * scale + atol
             worst = np.max(np.abs(got - expected) - bound)
             assert worst <= 0, f"{part}.{name} differs by more than the tolerance ({worst:.3g})"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene_id", scene_ids())
+def test_every_builtin_scenes_script_reproduces_its_default_run(scene_id, tmp_path):
+    """Each scene at its defaults (DOP853, 2 s). A run the app ends at a stop condition is
+    compared over the samples before the stop (the script lists stops, it does not apply them)."""
+    body = {"scene_id": scene_id, "t_end": 2, "method": "DOP853", "check_sensitivity": False}
+    run = client.post("/api/v1/simulate", json=body).json()
+    script = client.post("/api/v1/export/script", json=body)
+    assert script.status_code == 200, script.text
+    ours = _run_script(script.text, tmp_path)
+    shared = len(run["t"]) - (1 if run["stats"]["status"] == "stopped" else 0)
+    assert ours["t"][:shared] == pytest.approx(run["t"][:shared], abs=1e-12)
+    for part in ("q", "q_dot"):
+        for name, series in run[part].items():
+            expected = np.array(series[:shared])
+            got = np.array(ours[part][name][:shared])
+            bound = 1e-9 * np.maximum(1.0, np.abs(expected)) + 1e-9
+            assert np.all(np.abs(got - expected) <= bound), f"{scene_id} {part}.{name}"
 
 
 def test_the_script_names_no_user_identifier_in_its_code():
