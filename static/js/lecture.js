@@ -1,5 +1,9 @@
 // Lecture mode: large type and high contrast for a projector, the derivation revealed one step at a
 // time (→, space, PageDown reveal the next; ←, PageUp hide it), p plays or pauses, f full screen.
+// The derivation stands beside the animation, so in lecture mode it is moved next to it in the
+// page too: the tab order and a screen reader follow what the room sees. Its equations are fitted
+// to the narrower column (fit.js).
+import { fitEquations, watchEquations } from "./fit.js";
 
 export class Lecture {
   constructor({ list, toggle, counter, onToggle, onPlay }) {
@@ -9,6 +13,9 @@ export class Lecture {
     this.onToggle = onToggle;
     this.onPlay = onPlay;
     this.revealed = 1;
+    this.section = list.closest(".derivation");
+    this.home = this.section ? { parent: this.section.parentNode, next: this.section.nextSibling } : null;
+    watchEquations(list);
     if (toggle) toggle.addEventListener("click", () => this.set(!this.on));
     document.addEventListener("keydown", (e) => this.#key(e));
   }
@@ -19,12 +26,24 @@ export class Lecture {
 
   set(on) {
     document.body.classList.toggle("lecture", on);
+    document.documentElement.classList.toggle("lecture", on); // rem units follow the big type
+    this.#place(on);
     if (this.toggle) {
       this.toggle.textContent = on ? "Leave lecture mode" : "Lecture mode";
       this.toggle.setAttribute("aria-pressed", String(on));
     }
     this.apply();
     this.onToggle?.(on);
+  }
+
+  /** The derivation right after the animation's column in lecture mode, back home otherwise. */
+  #place(on) {
+    const main = this.home && this.home.parent.querySelector(":scope > .col-main");
+    if (!main) return;
+    if (on && main.nextSibling !== this.section) main.after(this.section);
+    else if (!on && this.section.parentNode === this.home.parent && this.section.nextSibling !== this.home.next) {
+      this.home.parent.insertBefore(this.section, this.home.next);
+    }
   }
 
   #key(e) {
@@ -62,5 +81,6 @@ export class Lecture {
     if (this.counter) this.counter.textContent = steps.length ? `step ${this.revealed} of ${steps.length}` : "";
     const last = steps[this.revealed - 1];
     if (scroll && this.on && last) last.scrollIntoView({ block: "nearest", behavior: "smooth" });
+    fitEquations(this.list); // a step just shown is measured only now
   }
 }

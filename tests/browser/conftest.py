@@ -115,3 +115,16 @@ def page(_session_page):
 def artifacts() -> Path:
     ARTIFACTS.mkdir(exist_ok=True)
     return ARTIFACTS
+
+
+@pytest.fixture
+def sized(_session_page):
+    """``sized(width, height)`` resizes the session page's window for this test (a projector, a
+    phone); the next test gets the usual 1300×900 back."""
+    page = _session_page.page
+
+    def size(width: int, height: int) -> None:
+        page.set_viewport_size({"width": width, "height": height})
+
+    yield size
+    page.set_viewport_size({"width": 1300, "height": 900})

@@ -1,0 +1,198 @@
+"""The pages fit their screen: a projector in lecture mode (1024×768, 1280×720, 1920×1080) and a
+phone (390×844).
+
+What "fits" means here, measured in the browser rather than taken from the stylesheet:
+- the page is no wider than the window (``scrollingElement.scrollWidth <= innerWidth``), and no
+  visible element's right edge lies beyond it, except inside a box that scrolls on purpose;
+- a display equation wider than its box is inside a box marked ``scrolls`` (the visible cue);
+- in lecture mode, every piece of text outside drawings (svg, canvas, plots, typeset math) is at
+  least 24 px, the size the issue asks for the back of a hall, and → / space / PageDown still
+  reveal one more step each;
+- on a phone, every panel but the animation can be folded (a <details> with a summary).
+"""
+
+from __future__ import annotations
+
+import json
+import urllib.request
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+LECTURE_SIZES = [(1024, 768), (1280, 720), (1920, 1080)]
+PHONE = (390, 844)
+
+
+def scene_ids(server: str) -> list[str]:
+    with urllib.request.urlopen(f"{server}/api/v1/scenes") as r:
+        return [s["id"] for s in json.load(r)]
+
+
+@pytest.fixture(scope="module")
+def scenes(server) -> list[str]:
+    return scene_ids(server)
+
+
+# Elements whose right edge lies beyond the window, not counting those inside a box that clips or
+# scrolls (overflow-x other than visible) narrower than the window, nor hidden ones.
+OVERFLOWING = """() => {
+  const W = document.documentElement.clientWidth;
+  const clipped = (el) => {
+    for (let p = el.parentElement; p && p !== document.body; p = p.parentElement) {
+      const o = getComputedStyle(p).overflowX;
+      if (o !== "visible" && p.getBoundingClientRect().right <= W + 1) return true;
+    }
+    return false;
+  };
+  const out = [];
+  for (const el of document.querySelectorAll("body *")) {
+    const r = el.getBoundingClientRect();
+    if (!r.width || r.right <= W + 1 || getComputedStyle(el).visibility === "hidden") continue;
+    if (el.closest(".skip-link") || clipped(el)) continue;
+    const name = `${el.tagName.toLowerCase()}#${el.id}.${String(el.className).slice(0, 40)}`;
+    out.push(`${name} right=${Math.round(r.right)}`);
+  }
+  const width = innerWidth;
+  return { scrollWidth: document.scrollingElement.scrollWidth, width, over: out.slice(0, 10) };
+}"""
+
+# Display equations wider than their box that carry no scroll cue.
+UNCUED = """() => {
+  const out = [];
+  const wide = (b) => b.scrollWidth > b.clientWidth + 1;
+  for (const m of document.querySelectorAll(".math")) {
+    if (m.offsetParent === null || !wide(m)) continue;
+    if (!m.classList.contains("scrolls")) out.push(m.dataset.latex.slice(0, 60));
+  }
+  for (const m of document.querySelectorAll('mjx-container[display="true"]')) {
+    if (m.closest(".math") || m.offsetParent === null) continue;
+    if (wide(m) && !m.classList.contains("scrolls")) out.push(m.textContent.slice(0, 60));
+  }
+  return out;
+}"""
+
+# Text smaller than `min` px: elements with their own visible text, outside drawings and math (and
+# sub- and superscripts, smaller by typographic convention).
+SMALL_TEXT = """(min) => {
+  const out = [];
+  const skip = "svg, canvas, mjx-container, .plot, .skip-link, script, style, option, sub, sup";
+  for (const el of document.querySelectorAll("main *, .topbar *")) {
+    if (el.closest(skip) || el.offsetParent === null) continue;
+    const own = [...el.childNodes].some((n) => n.nodeType === 3 && n.textContent.trim());
+    const control = el.matches("button, select, input, output, label, summary");
+    if (!own && !control) continue;
+    const size = parseFloat(getComputedStyle(el).fontSize);
+    if (size >= min - 0.01) continue;
+    const name = `${el.tagName.toLowerCase()}.${String(el.className).slice(0, 30)}`;
+    out.push(`${name} ${size}px: ${el.textContent.trim().slice(0, 30)}`);
+  }
+  return out.slice(0, 12);
+}"""
+
+# Every visible .math box has been fitted at its current width (fit.js records it).
+FITTED = """() => [...document.querySelectorAll("#steps .math")]
+  .filter((m) => m.offsetParent !== null)
+  .every((m) => m.dataset.fitWidth === String(m.clientWidth))"""
+
+
+def script_errors(page) -> list[str]:
+    """The page's own exceptions (a busy server's 503 under a loaded test machine is not one)."""
+    return [e for e in page.errors if e.startswith("page error")]
+
+
+def open_scene(p, server: str, scene: str, query: str = "") -> None:
+    p.goto(f"{server}/scenes/{scene}{query}")
+    p.wait_for_function(
+        "() => document.getElementById('steps').dataset.typeset === '1'", timeout=90_000
+    )
+
+
+def reveal_all(p) -> None:
+    n = p.locator("#steps > .step").count()
+    for _ in range(n):
+        p.keyboard.press("ArrowRight")
+    p.wait_for_function(f"() => document.getElementById('steps').dataset.revealed === '{n}'")
+
+
+def assert_fits(p, where: str) -> None:
+    p.wait_for_function(FITTED, timeout=30_000)
+    m = p.evaluate(OVERFLOWING)
+    assert m["scrollWidth"] <= m["width"], f"{where}: page {m['scrollWidth']} px wide: {m['over']}"
+    assert not m["over"], f"{where}: beyond the right edge: {m['over']}"
+    assert p.evaluate(UNCUED) == [], f"{where}: wide equations without a scroll cue"
+
+
+def test_lecture_mode_fits_the_projector_on_every_scene(server, page, sized, scenes):
+    p = page.page
+    for scene in scenes:
+        sized(*LECTURE_SIZES[0])
+        open_scene(p, server, scene, "?lecture=1")
+        reveal_all(p)
+        for w, h in LECTURE_SIZES:
+            sized(w, h)
+            where = f"{scene} at {w}×{h}"
+            assert_fits(p, where)
+            small = p.evaluate(SMALL_TEXT, 24)
+            assert not small, f"{where}: text under 24 px: {small}"
+        page.settle()  # no run in flight when the next scene is opened
+    assert not script_errors(page)
+
+
+def test_lecture_keys_reveal_one_step_each(server, page, sized):
+    p = page.page
+    sized(1280, 720)
+    open_scene(p, server, "double_pendulum", "?lecture=1")
+    revealed = lambda: int(p.evaluate("document.getElementById('steps').dataset.revealed"))  # noqa: E731
+    assert revealed() == 1
+    for k, key in enumerate(["ArrowRight", " ", "PageDown"], start=2):
+        p.keyboard.press(key)
+        p.wait_for_function(f"() => document.getElementById('steps').dataset.revealed === '{k}'")
+    p.keyboard.press("ArrowLeft")
+    assert revealed() == 3
+    # the derivation sits beside the animation, and so it comes right after it in the page
+    order = p.evaluate(
+        "[...document.querySelector('.scene-layout').children].map((c) => c.className)"
+    )
+    assert order[0].startswith("col-main") and "derivation" in order[1], order
+
+
+@pytest.mark.parametrize("path", ["/", "/editor"])
+def test_phone_catalog_and_editor_fit(server, page, sized, path):
+    p = page.page
+    sized(*PHONE)
+    p.goto(f"{server}{path}")
+    p.wait_for_load_state("load")
+    assert_fits_page(p, path)
+
+
+def assert_fits_page(p, where: str) -> None:
+    m = p.evaluate(OVERFLOWING)
+    assert m["scrollWidth"] <= m["width"], f"{where}: page {m['scrollWidth']} px wide: {m['over']}"
+    assert not m["over"], f"{where}: beyond the right edge: {m['over']}"
+
+
+def test_phone_every_scene_fits_and_folds(server, page, sized, scenes):
+    p = page.page
+    sized(*PHONE)
+    for scene in scenes:
+        open_scene(p, server, scene)
+        # open every fold, so what a student can open is measured too
+        p.evaluate("document.querySelectorAll('details.fold').forEach((d) => { d.open = true; })")
+        assert_fits(p, f"{scene} on a phone")
+        unfoldable = p.evaluate(
+            """[...document.querySelectorAll('main section.panel')]
+                 .filter((s) => !s.classList.contains('stage'))
+                 .filter((s) => !s.querySelector(':scope > details > summary, [aria-expanded]'))
+                 .map((s) => s.className)"""
+        )
+        assert unfoldable == [], f"{scene}: sections that cannot be folded: {unfoldable}"
+        page.settle()
+    # a phone starts with the secondary panels folded
+    open_scene(p, server, scenes[0])
+    closed = p.evaluate(
+        "[...document.querySelectorAll('details.fold:not([open])')]"
+        ".map((d) => d.parentElement.className)"
+    )
+    assert any("plots" in c for c in closed) and any("integrator" in c for c in closed), closed
+    assert not script_errors(page)
