@@ -207,6 +207,8 @@ def test_script_errors_name_the_field():
     assert r.json()["detail"][0]["field"] == "parameters.lenght"
     r = client.post("/api/v1/export/script", json={"scene_id": "no_such_scene"})
     assert r.status_code == 404
+    r = client.get("/api/v1/export/scenes/simple_pendulum/run.py?method=rk4&dt=0")
+    assert r.status_code == 422 and r.json()["detail"][0]["field"] == "dt"
     r = client.get("/api/v1/export/scenes/simple_pendulum/run.py?theta=nan")
     assert r.status_code == 422
     assert r.json()["detail"] == [

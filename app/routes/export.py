@@ -508,7 +508,8 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
         if (v := number(key)) is not None:
             fields[target] = v
     if method in METHODS and METHODS[method].kind == "fixed":
-        fields["dt"] = number("dt") or 0.01  # the page's default step
+        dt = number("dt")
+        fields["dt"] = 0.01 if dt is None else dt  # the page's default step
     if (v := number("fps")) is not None:
         fields["fps"] = v
     if errors:
