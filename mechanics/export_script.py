@@ -16,6 +16,7 @@ Names and titles appear only as Python string literals written by ``repr``.
 from __future__ import annotations
 
 import ast
+import inspect
 import json
 from typing import Any
 
@@ -163,7 +164,7 @@ def script_source(
         constants="\n".join(constants),
         equations=equations_source(compiled.native_inputs),
         n=n,
-        integrator=_FIXED if fixed else _ADAPTIVE,
+        integrator=fixed_step_source(method) if fixed else _ADAPTIVE,
     )
 
 
@@ -207,66 +208,29 @@ def run_script(scene_id: str | None, key: str | None, options: Any, origin: str)
         ) from None
 
 
-_FIXED = '''
-def step_euler(t, y, h):
-    return y + h * derivatives(t, y)
+def fixed_step_source(method: str) -> str:
+    """The app's own stepper for a fixed-step method (mechanics/integrators.py), copied into the
+    script by its source, with the helpers it calls: the script steps with the very arithmetic
+    the app steps with, and there is one implementation to maintain."""
+    from mechanics import integrators
+
+    stepper = integrators._STEPPERS[method]
+    parts = [inspect.getsource(stepper)]
+    if method == "implicit_midpoint":  # it checks finiteness and may give up
+        parts += [inspect.getsource(integrators._finite), inspect.getsource(integrators._Stop)]
+    return "\n\n".join(parts) + _FIXED_LOOP.replace("STEPPER", stepper.__name__)
 
 
-def step_symplectic_euler(t, y, h):
-    new = y + h * derivatives(t, y)  # q' first; q then moves with the new q'
-    new[:N] = y[:N] + h * new[N : 2 * N]
-    return new
-
-
-def step_rk4(t, y, h):
-    k1 = derivatives(t, y)
-    k2 = derivatives(t + h / 2, y + h / 2 * k1)
-    k3 = derivatives(t + h / 2, y + h / 2 * k2)
-    k4 = derivatives(t + h, y + h * k3)
-    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-
-
-def step_implicit_midpoint(t, y, h):
-    """y1 = y + h f(t + h/2, (y + y1)/2): fixed-point iteration, then Newton if it stalls."""
-    tm, tol = t + h / 2, 1e-14 * (1.0 + np.abs(y).max())
-    guess = z = y + h * derivatives(t, y)
-    last = math.inf
-    for _ in range(50):
-        nxt = y + h * derivatives(tm, (y + z) * 0.5)
-        change = np.abs(nxt - z).max()
-        z = nxt
-        rate = change / last
-        if change <= tol or (0 < rate < 0.5 and change * rate <= tol * (1 - rate)):
-            return z
-        if not rate < 1:
-            break
-        last = change
-    z, eye = guess, np.eye(len(y))
-    for _ in range(25):
-        mid = (y + z) / 2
-        fm = derivatives(tm, mid)
-        jac = np.empty((len(y), len(y)))
-        for j in range(len(y)):
-            e = 1.4901161193847656e-08 * max(1.0, abs(mid[j]))
-            probe = mid.copy()
-            probe[j] += e
-            jac[:, j] = (derivatives(tm, probe) - fm) / e
-        dz = np.linalg.solve(eye - h / 2 * jac, -(z - y - h * fm))
-        z = z + dz
-        if np.abs(dz).max() <= tol:
-            return z
-    return z
-
+_FIXED_LOOP = '''
 
 def integrate(y0, times):
     """Fixed steps landing on every sample: each interval gets ceil(dt_out / DT) equal steps."""
-    step = globals()["step_" + METHOD]
     out, y = [y0], y0
     for t0, t1 in zip(times[:-1], times[1:]):
         m = max(1, math.ceil((t1 - t0) / DT - 1e-9))
         h = (t1 - t0) / m
         for i in range(m):
-            y = step(t0 + i * h, y, h)
+            y = STEPPER(derivatives, t0 + i * h, y, h, N)
         out.append(y)
     return np.array(out)
 '''
