@@ -1,16 +1,27 @@
 // The animation canvas: the scene at one sample with a fading trail, sharp on any screen (device
 // pixel ratio), planar scenes in the x–y plane, 3-D ones in a perspective view turned by dragging.
-// A run that travels far (an Atwood machine, a block down a slope) gets a camera that pulls back.
+// A run that travels far (a disk rolling down a long slope) gets a camera that pans with it at one
+// fixed scale, never zooming out. The stages of one page that show the same spec (compare mode:
+// two methods side by side) share one scale, fitted to the union of their runs, so equal
+// distances look equal. The page's first stage carries the instruments (instruments.js).
 import { SceneGeometry } from "./geometry.js";
+import { Instruments } from "./instruments.js";
 import { drawCanvas } from "./render.js";
 import { sceneShapes } from "./shapes.js";
 import { View } from "./view.js";
 
 const ASPECT = 0.66; // height / width, for 3-D scenes and tall planar ones
+const PAD = { "2d": 34, "3d": 18 };
+const stages = new Set(); // every stage on the page: the ones showing the same spec share a scale
 
 export class Stage {
-  constructor(canvas) {
+  /** opts.instruments: mount the energy bars, stopwatch, ... under this canvas (default: the
+   * page's first stage does). */
+  constructor(canvas, opts = {}) {
     this.canvas = canvas;
+    const instruments = opts.instruments ?? stages.size === 0;
+    stages.add(this);
+    this.instruments = instruments ? new Instruments(this) : null;
     this.ctx = canvas.getContext("2d");
     this.geom = null;
     this.frame = 0;
@@ -32,16 +43,29 @@ export class Stage {
     this.canvas.height = Math.round(h * dpr);
     this.canvas.style.aspectRatio = `${w} / ${h}`;
     this.dpr = dpr;
-    if (this.geom) { this.#fit(); this.draw(this.frame); }
+    if (this.geom) { this.#fit(this.#peers()); this.draw(this.frame); }
   }
 
   setResult(spec, result, parameters) {
     this.geom = new SceneGeometry(spec, result, parameters);
     this.canvas.dataset.view = this.geom.is3D ? "3d" : "2d";
+    if (this.instruments) this.instruments.setResult(spec, result);
+    const peers = this.#peers();
+    for (const s of peers) s.#layout(peers);
+  }
+
+  /** The shown stages (this one included) drawing the same spec: they share one scale. */
+  #peers() {
+    if (!this.geom) return [this];
+    const shown = (s) => s === this || !s.canvas.closest("[hidden]");
+    return [...stages].filter((s) => s.geom && s.geom.spec === this.geom.spec && s.geom.is3D === this.geom.is3D && shown(s));
+  }
+
+  #layout(peers) {
     // A flat scene (a block on a floor) gets a flatter canvas, not a tall empty one.
     let aspect = ASPECT;
     if (!this.geom.is3D) {
-      const pts = this.geom.extent();
+      const pts = peers.flatMap((s) => s.geom.extent());
       const span = (k) => Math.max(...pts.map((p) => p[k])) - Math.min(...pts.map((p) => p[k]));
       aspect = Math.min(ASPECT, Math.max(0.42, span(1) / Math.max(span(0), 1e-9) + 0.2));
     }
@@ -50,7 +74,7 @@ export class Stage {
       this.cssW = 0; // force a resize
       this.#resize();
     }
-    this.#fit();
+    this.#fit(peers);
   }
 
   #firstSecond() {
@@ -60,32 +84,40 @@ export class Stage {
     return idx;
   }
 
-  #fit() {
+  /** One scale for the peers: the union of their runs fits; or, when the motion travels far
+   * compared with its first second, a fixed closer scale that pans with the bodies. */
+  #fit(peers = [this]) {
     const g = this.geom;
+    const pad = PAD[g.is3D ? "3d" : "2d"];
+    const box = (w, h) => new View(w, h, g.is3D);
+    // the smallest canvas of the peers decides, so the same scale fits every one of them
+    const w = Math.min(...peers.map((s) => s.cssW || this.cssW)), h = Math.min(...peers.map((s) => s.cssH || this.cssH));
+    const all = box(w, h).fit(peers.flatMap((s) => s.geom.extent()), pad);
     this.view = new View(this.cssW, this.cssH, g.is3D);
-    this.view.yaw = this.yaw;
-    this.view.pitch = this.pitch;
-    const pad = g.is3D ? 18 : 34;
+    Object.assign(this.view, { yaw: this.yaw, pitch: this.pitch });
     this.view.fit(g.extent(), pad);
+    this.view.scale = all.scale;
+    if (peers.length > 1) this.view.center = all.center;
     this.follow = false;
     if (!g.is3D) {
-      const early = new View(this.cssW, this.cssH).fit(g.extent(this.#firstSecond()), pad);
-      // Travels far compared with its first second: follow it instead of shrinking it to a dot.
-      if (early.scale > 6 * this.view.scale) {
+      const early = box(w, h).fit(peers.flatMap((s) => s.geom.extent(s.#firstSecond())), pad);
+      // Travels far compared with its first second: follow it at one scale instead of
+      // shrinking it to a dot; the scale keeps a few of the system's own sizes in view.
+      if (early.scale > 6 * all.scale) {
         this.follow = true;
-        this.closest = early.scale;
+        const size = Math.max(...peers.map((s) => s.geom.bodySize()));
+        const readable = size > 0 ? (Math.min(w, h) - 2 * pad) / (4 * size) : early.scale;
+        this.view.scale = Math.max(all.scale, Math.min(early.scale, readable));
       }
     }
+    this.canvas.dataset.scale = this.view.scale.toPrecision(6);
   }
 
   draw(i) {
     const g = this.geom;
     if (!g) return;
     this.frame = Math.max(0, Math.min(g.n - 1, i));
-    if (this.follow) {
-      this.view.fit(g.extent([this.frame]), 34);
-      this.view.scale = Math.min(this.view.scale, this.closest);
-    }
+    if (this.follow) this.view.center = g.focus(this.frame);
     const { ctx, canvas } = this;
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, canvas.width, canvas.height);
@@ -98,6 +130,8 @@ export class Stage {
     if (note) shapes.push({ t: "text", at: [10, 8 + font], text: note, color: "#868e96", size: font });
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
+    canvas.dataset.pieces = [...new Set(shapes.map((s) => s.piece).filter(Boolean))].sort().join(" ");
+    if (this.instruments) this.instruments.update(this.frame);
   }
 
   #drag(e) {

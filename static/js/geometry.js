@@ -1,10 +1,16 @@
 // What a scene looks like, read from its spec and one simulated run: which bodies hang on rods,
 // which slide along a straight track (a floor, an incline), which hang on a rope from a pulley,
-// which ride a spinning hoop or a cone, how big a rolling wheel is, where the supports are.
+// which ride a spinning hoop or a cone or a wire of any shape (swept from the spec's position at
+// the run's parameters), how big a rolling wheel is, where the supports are (fixed points only).
 // Nothing here is scene-specific: every drawing decision is inferred from the data.
+import { compile } from "./expr.js";
 
 export const COLORS = ["#1f6feb", "#d9480f", "#2f9e44", "#9c36b5", "#e8590c", "#0c8599"];
 const REL = 1e-6; // relative tolerance for "constant" along a run
+const SWEEP = 121; // points along a swept wire
+// spec -> {q: [lo, hi]}: the range each coordinate covered in the last full run, so a one-sample
+// run (an equilibrium sketch) of the same spec sweeps its wire over the same stretch.
+const lastRanges = new WeakMap();
 
 export const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 export const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -26,6 +32,14 @@ function positionFrame(body) {
   return p && !Array.isArray(p) && p.frame && p.frame !== "N" ? p.frame : null;
 }
 
+/** The components, frame (null for N) and anchor of a body's or point's position. */
+function positionParts(position) {
+  if (Array.isArray(position)) return { components: position, frame: null, anchor: "O" };
+  if (!position) return null;
+  return { components: position.components || [], frame: position.frame && position.frame !== "N" ? position.frame : null,
+    anchor: position.from || "O" };
+}
+
 /** A number for a mass given as a parameter name or a numeral; 1 when it is an expression. */
 function massValue(mass, parameters) {
   if (typeof mass === "number") return mass;
@@ -41,6 +55,8 @@ export class SceneGeometry {
     this.P = result.positions;
     this.n = result.t.length;
     this.bodies = spec.bodies.filter((b) => this.P[b.name]);
+    this.parameters = parameters;
+    this.coordinates = new Set(spec.coordinates || []);
     const g = spec.gravity ? [...spec.gravity.direction, 0].slice(0, 3) : null;
     this.down = g ? unit(g) : [0, -1, 0];
     this.hasGravity = Boolean(g);
@@ -58,7 +74,15 @@ export class SceneGeometry {
     this.ropes = []; // {body, point}: a vertical rope up to a fixed point's height
     this.pulleys = new Map(); // point -> radius
     this.wheels = new Map(); // rigid body -> radius (world units), inferred from rolling
+    this.wires = []; // {body, anchor, frame, q, local: [[x, y, z]...] in the frame, from the anchor}
+    this.ranges = this.#ranges();
     for (const b of this.bodies) this.#analyze(b);
+    // a wire or hoop turning about an axis in the picture's plane needs depth to be seen
+    const spinsInPlane = (frame) => {
+      const f = (spec.frames || []).find((x) => x.name === frame);
+      return f && f.axis !== "z" && this.frameSpins(frame);
+    };
+    if ([...this.wires, ...this.hoops].some((w) => spinsInPlane(w.frame))) this.is3D = true;
     this.supports = this.#supports();
   }
 
@@ -71,12 +95,159 @@ export class SceneGeometry {
     return -dot(point, this.down);
   }
 
+  /** Fixed: constant along the run and, by its spec, depending on no coordinate and not on t (a
+   * one-sample run, an equilibrium sketch, cannot tell a resting body from a support). */
   #isFixed(name) {
     const p = this.P[name];
+    if (!this.#staticBySpec(name, 0)) return false;
     return ["x", "y", "z"].every((c) => {
       const v = p[c], v0 = v[0];
       return v.every((x) => Math.abs(x - v0) <= 1e-12 * (1 + Math.abs(v0)));
     });
+  }
+
+  /** The names a frame's orientation depends on (its angle's and its parents'); null when an
+   * angle cannot be read. */
+  frameNames(frame, depth = 0) {
+    if (!frame || frame === "N" || depth > 20) return new Set();
+    const f = (this.spec.frames || []).find((x) => x.name === frame);
+    if (!f) return new Set();
+    const angle = compile(f.angle), up = this.frameNames(f.parent, depth + 1);
+    return angle && up ? new Set([...angle.names, ...up]) : null;
+  }
+
+  /** Whether a frame turns (its angle, or a parent's, depends on a coordinate or on t). */
+  frameMoves(frame) {
+    const names = this.frameNames(frame);
+    return !names || [...names].some((n) => n === "t" || this.coordinates.has(n));
+  }
+
+  /** Whether a frame is driven round by the clock alone (a spinning hoop, not a coordinate). */
+  frameSpins(frame) {
+    const names = this.frameNames(frame);
+    return Boolean(names) && names.has("t") && ![...names].some((n) => this.coordinates.has(n));
+  }
+
+  #staticBySpec(name, depth) {
+    if (name === "O" || depth > 20) return true;
+    const item = [...(this.spec.points || []), ...this.spec.bodies].find((x) => x.name === name);
+    if (!item) return true; // not described: the samples decide
+    const parts = positionParts(item.position);
+    if (!parts) return true;
+    const comps = parts.components.map(compile);
+    if (comps.some((c) => !c)) return true;
+    const varies = comps.some((c) => [...c.names].some((n) => n === "t" || this.coordinates.has(n)));
+    const allZero = comps.every((c) => !c.names.size && c({}) === 0);
+    if (varies || (!allZero && this.frameMoves(parts.frame))) return false;
+    return this.#staticBySpec(parts.anchor, depth + 1);
+  }
+
+  /** Each coordinate's range over this run; a run too short to show one borrows the last full
+   * run's of the same spec. */
+  #ranges() {
+    const out = {};
+    const q = this.result.q || {};
+    for (const [name, v] of Object.entries(q)) {
+      if (v.length) out[name] = [Math.min(...v), Math.max(...v)];
+    }
+    if (this.n >= 3) lastRanges.set(this.spec, out);
+    else {
+      const before = lastRanges.get(this.spec) || {};
+      for (const [name, r] of Object.entries(before)) {
+        if (out[name] && out[name][0] >= r[0] - 1e-9 && out[name][1] <= r[1] + 1e-9) out[name] = r;
+      }
+    }
+    return out;
+  }
+
+  /** The frame's axes at sample i as three rows (identity for N). */
+  axesAt(frame, i) {
+    if (!frame) return [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+    const F = this.result.frames[frame][i];
+    return [F.slice(0, 3), F.slice(3, 6), F.slice(6, 9)];
+  }
+
+  /** A wire's (or any frame-fixed curve's) points in the world at sample i. */
+  wireAt(w, i) {
+    const A = this.axesAt(w.frame, i), o = this.at(w.anchor, i);
+    return w.local.map((p) => add(o, add(mul(A[0], p[0]), add(mul(A[1], p[1]), mul(A[2], p[2])))));
+  }
+
+  /**
+   * The curve a body is held to, when its position (in its frame, from its anchor) depends on a
+   * single coordinate and not on t: the positions as that coordinate sweeps its range with
+   * everything else as at sample 0. A full turn for a coordinate seen only inside sin, cos, ...;
+   * else the range the run covered and a quarter more each way. Null when the spec's expressions
+   * do not reproduce the run's position at sample 0 (then nothing is drawn rather than a guess).
+   */
+  #sweep(body) {
+    const parts = positionParts(body.position);
+    if (!parts || !this.P[parts.anchor]) return null;
+    if (parts.frame && !(this.result.frames || {})[parts.frame]) return null;
+    const comps = parts.components.map(compile);
+    if (comps.some((c) => !c)) return null;
+    while (comps.length < 3) comps.push(compile(0));
+    const turns = this.frameNames(parts.frame);
+    if (!turns || [...turns].some((n) => this.coordinates.has(n))) return null; // a swinging frame: no fixed curve
+    const used = new Set(comps.flatMap((c) => [...c.names]));
+    const qs = [...used].filter((n) => this.coordinates.has(n));
+    if (qs.length !== 1 || used.has("t")) return null;
+    const q = qs[0];
+    const env = { ...this.parameters, t: this.result.t[0] };
+    for (const [name, v] of Object.entries(this.result.q || {})) env[name] = v[0];
+    const local = (value) => comps.map((c) => c({ ...env, [q]: value }));
+    // the spec, evaluated here, must put the body where the run did
+    const A = this.axesAt(parts.frame, 0), o = this.at(parts.anchor, 0), l0 = local(env[q]);
+    const here = add(o, add(mul(A[0], l0[0]), add(mul(A[1], l0[1]), mul(A[2], l0[2]))));
+    const there = this.at(body.name, 0);
+    if (!(norm(sub(here, there)) <= 1e-6 * (1 + norm(there)))) return null;
+    const closed = comps.every((c) => !c.names.has(q) || c.periodic.has(q));
+    let lo, hi;
+    if (closed) [lo, hi] = [env[q] - Math.PI, env[q] + Math.PI];
+    else {
+      [lo, hi] = this.ranges[q] || [env[q], env[q]];
+      const span = hi - lo > 1e-9 ? hi - lo : Math.max(1, Math.abs(env[q]));
+      [lo, hi] = [lo - 0.25 * span, hi + 0.25 * span];
+    }
+    const pts = [];
+    for (let k = 0; k < SWEEP; k++) {
+      const p = local(lo + ((hi - lo) * k) / (SWEEP - 1));
+      if (p.every(Number.isFinite)) pts.push(p);
+    }
+    if (pts.length < 2) return null;
+    return { body: body.name, anchor: parts.anchor, frame: parts.frame, q, local: pts, closed };
+  }
+
+  /** One sample shows no motion: what holds the body is read from its swept curve instead. */
+  #fromSweep(body, w) {
+    const d = w.local.map(norm);
+    const mean = d.reduce((s, v) => s + v, 0) / d.length;
+    const constant = mean > 1e-9 && Math.max(...d) - Math.min(...d) <= REL * mean;
+    if (constant) {
+      const flat = [0, 1, 2].find((k) => w.local.every((p) => Math.abs(p[k]) <= REL * mean));
+      if (this.frameSpins(w.frame) && flat !== undefined) {
+        this.hoops.push({ body: w.body, anchor: w.anchor, frame: w.frame,
+          axes: [0, 1, 2].filter((k) => k !== flat), radius: mean });
+      } else this.links.push([w.anchor, w.body]);
+      return;
+    }
+    const first = w.local[0], last = w.local[w.local.length - 1];
+    const reach = norm(sub(last, first));
+    const dir = unit(sub(last, first));
+    const straight = reach > 1e-9 && w.local.every((p) => {
+      const r = sub(p, first);
+      return norm(sub(r, mul(dir, dot(r, dir)))) <= REL * reach;
+    });
+    if (straight && !this.frameMoves(w.frame)) {
+      const world = this.wireAt(w, 0), here = this.at(w.body, 0);
+      const dirW = unit(sub(world[world.length - 1], world[0]));
+      if (this.hasGravity && Math.abs(dot(dirW, this.down)) > Math.cos(0.17) && this.#rope(w.body)) return;
+      const s = world.map((p) => dot(sub(p, here), dirW));
+      const span = Math.max(...s) - Math.min(...s);
+      this.tracks.push({ body: w.body, origin: here, dir: dirW, lo: -0.2 * span, hi: 0.2 * span });
+      return;
+    }
+    this.wires.push(w);
   }
 
   /** The body's position relative to `anchor`, in the axes of `frame`, at sample i. */
@@ -96,6 +267,11 @@ export class SceneGeometry {
 
   #analyze(body) {
     const name = body.name;
+    const wire = this.#sweep(body);
+    if (wire && this.n < 3) {
+      this.#fromSweep(body, wire);
+      return;
+    }
     const anchor = bodyAnchor(body);
     const idx = this.#samples();
     const frame = positionFrame(body);
@@ -132,11 +308,12 @@ export class SceneGeometry {
         return;
       }
     }
-    this.#track(body, idx);
+    if (!this.#track(body, idx) && wire) this.#fromSweep(body, wire);
   }
 
+  /** A straight line in the world (a floor, an incline, a rope): true when it is one. */
   #track(body, idx) {
-    if (idx.length < 3) return;
+    if (idx.length < 3) return false;
     const name = body.name;
     const p0 = this.at(name, idx[0]);
     let far = p0, reach = 0;
@@ -144,14 +321,14 @@ export class SceneGeometry {
       const d = norm(sub(this.at(name, i), p0));
       if (d > reach) { reach = d; far = this.at(name, i); }
     }
-    if (reach < 1e-9) return;
+    if (reach < 1e-9) return false; // at rest: the spec's sweep, if any, decides
     const dir = unit(sub(far, p0));
     const s = idx.map((i) => dot(sub(this.at(name, i), p0), dir));
     const off = Math.max(...idx.map((i, k) => norm(sub(sub(this.at(name, i), p0), mul(dir, s[k])))));
-    if (off > REL * reach) return; // not a straight line
+    if (off > REL * reach) return false; // not a straight line
     if (this.hasGravity && Math.abs(dot(dir, this.down)) > Math.cos(0.17)) {
       this.#rope(name); // straight up and down: on a rope, never on a vertical "floor"
-      return;
+      return true;
     }
     this.tracks.push({ body: name, origin: p0, dir, lo: Math.min(...s), hi: Math.max(...s) });
     if (body.kind === "rigid_body" && body.frame && this.result.frames[body.frame]) {
@@ -166,6 +343,7 @@ export class SceneGeometry {
       const turned = ang[ang.length - 1] - ang[0];
       if (Math.abs(turned) > 1e-6) this.wheels.set(name, Math.abs((s[s.length - 1] - s[0]) / turned));
     }
+    return true;
   }
 
   #rope(name) {
@@ -226,6 +404,23 @@ export class SceneGeometry {
       .filter((n) => this.P[n] && !used.has(n));
   }
 
+  /** The size of the system itself (a wheel's diameter, a rod's length, a hoop's): a camera
+   * that follows the motion keeps a few of these in view. 0 when nothing has a size. */
+  bodySize() {
+    const sizes = [0];
+    for (const r of this.wheels.values()) sizes.push(2 * r);
+    for (const r of this.pulleys.values()) sizes.push(2 * r);
+    for (const h of this.hoops) sizes.push(2 * h.radius);
+    for (const [a, b] of this.links) sizes.push(norm(sub(this.at(a, 0), this.at(b, 0))));
+    return Math.max(...sizes);
+  }
+
+  /** Where a following camera looks at sample i: the middle of the bodies. */
+  focus(i) {
+    const pts = this.bodies.map((b) => this.at(b.name, i));
+    return mul(pts.reduce(add, [0, 0, 0]), 1 / (pts.length || 1));
+  }
+
   /** World points the view must fit: every position along the run and the drawn extras. */
   extent(frames = null) {
     const idx = frames || this.#samples();
@@ -241,6 +436,13 @@ export class SceneGeometry {
     for (const [p, r] of this.pulleys) around(this.at(p, 0), r);
     for (const [b, r] of this.wheels) for (const i of idx) around(this.at(b, i), r);
     for (const h of this.hoops) around(this.at(h.anchor, 0), h.radius);
+    const every = Math.max(1, Math.floor(idx.length / 40));
+    for (const w of this.wires) {
+      for (let k = 0; k < idx.length; k += every) {
+        const world = this.wireAt(w, idx[k]);
+        for (let j = 0; j < world.length; j += 6) pts.push(world[j]);
+      }
+    }
     for (const c of this.cones) {
       const apex = this.at(c.anchor, 0);
       const h = c.length * Math.cos(c.halfAngle), r = c.length * Math.sin(c.halfAngle);

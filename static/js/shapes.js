@@ -1,7 +1,7 @@
 // A scene at one sample, as flat screen primitives (lines, polygons, circles, arrows, text) that
 // render.js draws on a canvas or writes as SVG: the animation, the catalog drawings and the
 // free-body diagram all come from here.
-import { add, mul, sub, unit } from "./geometry.js";
+import { add, dot, mul, sub } from "./geometry.js";
 
 const INK = "#343a40";
 const GROUND = "#868e96";
@@ -21,6 +21,7 @@ export function sceneShapes(geom, view, i, opts = {}) {
   if (geom.is3D && o.axes !== false) floorAndAxes(geom, view, out);
   grounds(geom, view, rad, out);
   for (const h of geom.hoops) hoop(geom, view, h, i, out);
+  for (const w of geom.wires) wire(geom, view, w, i, out);
   for (const c of geom.cones) cone(geom, view, c, i, out);
   for (const [p, r] of geom.pulleys) {
     const [cx, cy] = P(p);
@@ -47,17 +48,21 @@ export function sceneShapes(geom, view, i, opts = {}) {
   };
   const doubled = new Set([...(geom.spec.springs || []), ...(geom.spec.dampers || [])]
     .map((s) => [s.a, s.b].sort().join("|")).filter((k, n, all) => all.indexOf(k) !== n));
-  for (const s of geom.spec.springs || []) {
-    if (!geom.P[s.a] || !geom.P[s.b]) continue;
-    const two = doubled.has([s.a, s.b].sort().join("|"));
-    const shift = two ? (offsetFor(s.a, s.b) ? 1 : -1) * 0.7 * o.radius : 0;
-    spring(P(s.a), P(s.b), shift, two ? 0.45 * o.radius : 6, o.muted ? "#adb5bd" : "#6c757d", out);
-  }
-  for (const d of geom.spec.dampers || []) {
-    if (!geom.P[d.a] || !geom.P[d.b]) continue;
-    const two = doubled.has([d.a, d.b].sort().join("|"));
-    const shift = two ? (offsetFor(d.a, d.b) ? 1 : -1) * 0.7 * o.radius : 0;
-    damper(P(d.a), P(d.b), shift, two ? 0.45 * o.radius : 6, o.muted ? "#adb5bd" : "#6c757d", out);
+  const elements = []; // [label, middle (px), half-width]: named after the pieces are drawn
+  for (const [list, kind, draw, strength] of [[geom.spec.springs, "spring", spring, "k"], [geom.spec.dampers, "damper", damper, "c"]]) {
+    for (const s of list || []) {
+      if (!geom.P[s.a] || !geom.P[s.b]) continue;
+      const two = doubled.has([s.a, s.b].sort().join("|"));
+      const shift = two ? (offsetFor(s.a, s.b) ? 1 : -1) * 0.7 * o.radius : 0;
+      const amp = two ? 0.45 * o.radius : 6;
+      const a = P(s.a), b = P(s.b);
+      draw(a, b, shift, amp, o.muted ? "#adb5bd" : "#6c757d", out);
+      out[out.length - 1].piece = kind;
+      const len = Math.hypot(b[0] - a[0], b[1] - a[1]) || 1;
+      const mid = [(a[0] + b[0]) / 2 - ((b[1] - a[1]) / len) * shift, (a[1] + b[1]) / 2 + ((b[0] - a[0]) / len) * shift];
+      const name = s.name || (typeof s[strength] === "string" && /^\w+$/.test(s[strength]) ? s[strength] : kind);
+      elements.push([name, mid, amp, [-(b[1] - a[1]) / len, (b[0] - a[0]) / len], Math.sign(shift)]);
+    }
   }
   for (const [a, b] of geom.links) {
     out.push({ t: "line", a: P(a), b: P(b), color: o.muted ? "#adb5bd" : "#495057", width: 3, cap: "round" });
@@ -76,6 +81,18 @@ export function sceneShapes(geom, view, i, opts = {}) {
       const [x, y] = P(b.name);
       const r = Math.max(rad(b.name), geom.wheels.has(b.name) ? geom.wheels.get(b.name) * view.scale : 0);
       placeLabel(out, occupied, [x, y], r, b.name, o.muted ? INK : "#212529", w, h, o.font);
+    }
+    // springs and dampers by name, clear of the bodies, their names and each other
+    // (a spring and a damper side by side are each named on their outer side)
+    const size = o.font - 1;
+    for (const [, [x, y], amp] of elements) occupied.push([x - amp - 2, y - amp - 2, x + amp + 2, y + amp + 2]);
+    for (const [name, mid, amp, n, side] of elements) {
+      if (!side) { placeLabel(out, occupied, mid, amp + 2, name, "#6c757d", w, h, size); continue; }
+      const reach = amp + 3 + size * (0.5 + 0.5 * Math.abs(n[0]));
+      const c = [mid[0] + n[0] * side * reach, mid[1] + n[1] * side * reach];
+      const tw = 0.6 * size * name.length;
+      out.push({ t: "text", at: [c[0], c[1] + 0.35 * size], text: name, color: "#6c757d", size, halo: true, align: "center" });
+      occupied.push([c[0] - tw / 2, c[1] - size / 2, c[0] + tw / 2, c[1] + size / 2]);
     }
   }
   if (o.scaleBar && !geom.is3D) scaleBar(view, out, o.font - 1);
@@ -184,13 +201,55 @@ function hoop(geom, view, h, i, out) {
   const F = geom.result.frames[h.frame][i];
   const axis = (k) => F.slice(3 * k, 3 * k + 3);
   const c = geom.at(h.anchor, i);
-  out.push({ t: "poly", pts: circle3(view, c, axis(h.axes[0]), axis(h.axes[1]), h.radius), color: "#868e96", width: 3, alpha: 0.9 });
+  out.push({ t: "poly", pts: circle3(view, c, axis(h.axes[0]), axis(h.axes[1]), h.radius), color: "#868e96", width: 3, alpha: 0.9, piece: "hoop" });
   out.push({ t: "circle", c: view.project(c).slice(0, 2), r: 3, fill: "#868e96" });
-  const spec = (geom.spec.frames || []).find((f) => f.name === h.frame);
-  if (spec && spec.parent === "N") {
-    const a = [0, 0, 0]; a["xyz".indexOf(spec.axis)] = 1.25 * h.radius;
-    out.push({ t: "line", a: view.project(sub(c, a)), b: view.project(add(c, a)), color: "#adb5bd", width: 1.5, dash: [6, 4] });
+  const spin = spinAxis(geom, h.frame);
+  if (spin !== null) spinMarks(geom, view, h.frame, spin, c, -1.25 * h.radius, 1.3 * h.radius, 0.18 * h.radius, i, out);
+}
+
+/** The curve a bead rides on (swept from its position function), turning with its frame. */
+function wire(geom, view, w, i, out) {
+  const world = geom.wireAt(w, i);
+  const pts = world.map((p) => view.project(p).slice(0, 2));
+  out.push({ t: "poly", pts, color: "#868e96", width: 3, alpha: 0.9, cap: "round", closed: w.closed, piece: "wire" });
+  const axis = spinAxis(geom, w.frame);
+  if (axis === null) return;
+  // the spin axis through the anchor, as long as the wire reaches along it (and a bit more)
+  const along = w.local.map((p) => p[axis]);
+  const lo = Math.min(0, ...along), hi = Math.max(0, ...along);
+  const size = Math.max(hi - lo, ...w.local.map((p) => Math.hypot(...p.filter((_, k) => k !== axis))), 1e-6);
+  spinMarks(geom, view, w.frame, axis, geom.at(w.anchor, i), lo - 0.15 * size, hi + 0.2 * size, 0.12 * size, i, out);
+}
+
+/** The index (0, 1, 2) of the axis a frame turns about, when it turns; else null. */
+function spinAxis(geom, frame) {
+  if (!frame || !geom.frameSpins(frame) || !(geom.result.frames || {})[frame]) return null;
+  const spec = (geom.spec.frames || []).find((f) => f.name === frame);
+  const k = spec ? "xyz".indexOf(spec.axis) : -1;
+  return k >= 0 ? k : null;
+}
+
+/** A frame's spin axis (dashed, from lo to hi along it through `origin`) and an arrow around
+ * it near the top that turns the way the frame turns. */
+function spinMarks(geom, view, frame, axis, origin, lo, hi, r, i, out) {
+  const A = geom.axesAt(frame, i);
+  const e = A[axis], e1 = A[(axis + 1) % 3], e2 = A[(axis + 2) % 3];
+  out.push({ t: "line", a: view.project(add(origin, mul(e, lo))), b: view.project(add(origin, mul(e, hi))),
+    color: "#adb5bd", width: 1.5, dash: [6, 4], piece: "axis" });
+  let sense = 1;
+  if (geom.n > 1) { // which way the frame turns: e1 moves toward e2 or away
+    const j = i + 1 < geom.n ? i + 1 : i - 1;
+    const B = geom.axesAt(frame, j);
+    sense = Math.sign(dot(sub(B[(axis + 1) % 3], e1), e2) * (j > i ? 1 : -1)) || 1;
   }
+  const c = add(origin, mul(e, hi - 0.3 * r));
+  const arc = [];
+  for (let k = 0; k <= 24; k++) {
+    const a = sense * (0.25 + (1.4 * Math.PI * k) / 24);
+    arc.push(view.project(add(c, add(mul(e1, r * Math.cos(a)), mul(e2, r * Math.sin(a))))).slice(0, 2));
+  }
+  out.push({ t: "poly", pts: arc.slice(0, -1), color: "#868e96", width: 1.5, piece: "spin" });
+  out.push({ t: "arrow", a: arc[arc.length - 3], b: arc[arc.length - 1], color: "#868e96", width: 1.5, head: 7 });
 }
 
 function cone(geom, view, c, i, out) {

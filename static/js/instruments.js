@@ -1,0 +1,329 @@
+// What a student expects from a PhET simulation, beside the animation: live energy bars (T, V, E
+// and the work of the non-conservative forces and of the drives, at the sample on screen), a
+// stopwatch and a period timer that read the simulation's clock (not the wall clock: at 0.25×
+// speed a period still measures what it is), gravity presets that move the scene's own gravity
+// control the way a user would, and single steps (one sample back or forward, buttons and the
+// , and . keys while paused). Built from JS next to the stage's canvas; styled inline, so the page's
+// stylesheet needs nothing new. Data attributes (data-value, data-t, data-period, ...) let the
+// browser tests read what is shown.
+
+const NS = "http://www.w3.org/2000/svg";
+const BARS = [ // key in the run's `energy`, label, colour; the work bars only when the run has any
+  ["T", "T", "#1f6feb", false],
+  ["V", "V", "#2f9e44", false],
+  ["E", "E", "#212529", false],
+  ["W_nc", "W_NC", "#e8590c", true],
+  ["W_drive", "W_drive", "#9c36b5", true],
+];
+export const GRAVITY = [["Earth", 9.81], ["Moon", 1.62], ["Mars", 3.71], ["Jupiter", 24.79], ["zero g", 0]];
+const BOX = "border:1px solid #dee2e6;border-radius:6px;padding:6px 8px;background:#fff;min-width:0";
+const HEAD = "font-size:12px;font-weight:600;color:#495057;margin:0 0 4px";
+const SMALL = "font-size:11px;color:#6c757d;margin:4px 0 0;line-height:1.3";
+const BUTTON = "font-size:12px;padding:2px 8px;margin:0 4px 0 0";
+
+const el = (tag, props = {}, style = "") => {
+  const e = Object.assign(document.createElement(tag), props);
+  if (style) e.style.cssText = style;
+  return e;
+};
+const fmtJ = (v) => (Math.abs(v) >= 100 || (Math.abs(v) < 0.01 && v !== 0) ? v.toExponential(2) : v.toFixed(3));
+
+export class Instruments {
+  constructor(stage) {
+    this.stage = stage;
+    this.result = null;
+    this.spec = null;
+    this.watch = { running: false, elapsed: 0, last: null };
+    this.box = el("div", { className: "instruments", id: "instruments" },
+      "display:flex;flex-wrap:wrap;gap:8px;margin-top:8px;align-items:stretch");
+    this.box.setAttribute("aria-label", "instruments");
+    const section = stage.canvas.closest("section") || stage.canvas.parentElement;
+    const playback = section.querySelector(".playback");
+    (playback || section.lastElementChild).after(this.box);
+    this.#stepButtons(playback);
+    this.#energyPanel();
+    this.#clocks();
+    this.#gravityPanel();
+    document.addEventListener("keydown", (e) => this.#key(e));
+  }
+
+  // ------------------------------------------------------------------ single step
+  #stepButtons(playback) {
+    const make = (text, by, title) => {
+      const b = el("button", { type: "button", textContent: text, title, className: "step" }, "min-width:2.6em");
+      b.dataset.step = String(by);
+      b.addEventListener("click", () => this.step(by));
+      return b;
+    };
+    this.back = make("◀|", -1, "one sample back (,)");
+    this.fwd = make("|▶", 1, "one sample forward (.)");
+    const play = playback && playback.querySelector("#play");
+    if (play) play.after(this.back, this.fwd);
+    else this.box.append(this.back, this.fwd);
+  }
+
+  #paused() {
+    const play = document.getElementById("play");
+    return !play || play.getAttribute("aria-pressed") === "false";
+  }
+
+  #key(e) {
+    if (e.key !== "," && e.key !== ".") return;
+    if (e.target.closest && e.target.closest("input, select, textarea, [contenteditable]")) return;
+    if (!this.#paused()) return;
+    e.preventDefault();
+    this.step(e.key === "." ? 1 : -1);
+  }
+
+  /** One sample back or forward: through the page's time slider (it pauses the playback and sets
+   * the clock), given the exact time of the sample so a long run is not rounded to 1/1000. */
+  step(by) {
+    const r = this.result, scrub = document.getElementById("scrub");
+    if (!r || !scrub || r.t.length < 2) return;
+    const end = r.t[r.t.length - 1];
+    const target = Math.max(0, Math.min(r.t.length - 1, this.stage.frame + by));
+    scrub.step = "any";
+    scrub.value = String(end > 0 ? (1000 * r.t[target]) / end : 0);
+    scrub.dispatchEvent(new Event("input", { bubbles: true }));
+  }
+
+  // ------------------------------------------------------------------ energy bars
+  #energyPanel() {
+    const box = el("div", { className: "energy-bars" }, `${BOX};flex:1 1 260px`);
+    box.append(el("p", { textContent: "Energy (J), now" }, HEAD));
+    this.svg = document.createElementNS(NS, "svg");
+    this.svg.setAttribute("viewBox", "0 0 300 150");
+    this.svg.setAttribute("role", "img");
+    this.svg.setAttribute("aria-label", "energy bars");
+    this.svg.style.cssText = "width:100%;max-width:360px;height:auto;display:block";
+    this.caption = el("p", {}, SMALL);
+    box.append(this.svg, this.caption);
+    this.box.append(box);
+  }
+
+  #buildBars() {
+    const e = this.result.energy || {};
+    const shown = BARS.filter(([k, , , work]) => e[k] && (!work || e[k].some((v) => Math.abs(v) > 1e-12)));
+    let lo = 0, hi = 0;
+    for (const [k] of shown) for (const v of e[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    if (hi - lo < 1e-12) hi = lo + 1;
+    const top = 14, bottom = 126, left = 44, width = 300 - left - 6;
+    const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
+    this.axis = { y, shown };
+    const slot = width / Math.max(shown.length, 1);
+    const parts = [];
+    const line = (x1, y1, x2, y2, color, extra = "") =>
+      `<line x1="${x1}" y1="${y1.toFixed(1)}" x2="${x2}" y2="${y2.toFixed(1)}" stroke="${color}"${extra}/>`;
+    parts.push(line(left, top, left, bottom, "#ced4da"));
+    for (const v of [hi, 0, lo]) {
+      if (v !== 0 && Math.abs(v) < 1e-12) continue;
+      parts.push(`<text x="${left - 4}" y="${(y(v) + 3).toFixed(1)}" font-size="9" fill="#868e96" text-anchor="end">${fmtJ(v)}</text>`);
+    }
+    parts.push(line(left, y(0), 300 - 4, y(0), "#868e96"));
+    shown.forEach(([k, label, color], j) => {
+      const x = left + slot * j + slot * 0.2, w = slot * 0.6;
+      parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
+      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="10" font-size="9" fill="#495057" text-anchor="middle"></text>`);
+      parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="142" font-size="11" fill="${color}" text-anchor="middle" font-style="italic">${label}</text>`);
+    });
+    this.svg.innerHTML = parts.join("");
+    this.rects = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`rect[data-key="${k}"]`)]));
+    this.labels = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`text[data-value-of="${k}"]`)]));
+    const works = shown.filter(([, , , w]) => w).map(([, l]) => l);
+    this.caption.textContent = "All bars on one axis, over the whole run. V's zero is arbitrary (where " +
+      "the datum is put), so only changes in V and E mean something." +
+      (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.` : " No work is done from outside: E stays constant.");
+  }
+
+  #updateBars(i) {
+    if (!this.axis) return;
+    const e = this.result.energy;
+    const { y } = this.axis;
+    for (const [k, rect] of Object.entries(this.rects)) {
+      const v = e[k][i];
+      const a = y(0), b = y(Number.isFinite(v) ? v : 0);
+      rect.setAttribute("y", Math.min(a, b).toFixed(2));
+      rect.setAttribute("height", Math.abs(b - a).toFixed(2));
+      rect.dataset.value = String(v);
+      const label = this.labels[k];
+      label.textContent = fmtJ(v);
+      label.setAttribute("y", String(Math.max(9, Math.min(a, b) - 3).toFixed(1)));
+    }
+  }
+
+  // ------------------------------------------------------------------ stopwatch, period timer
+  #clocks() {
+    const box = el("div", { className: "clocks" }, `${BOX};flex:1 1 200px`);
+    box.append(el("p", { textContent: "Stopwatch (simulation time)" }, HEAD));
+    this.watchOut = el("output", { id: "stopwatch", textContent: "0.00 s" },
+      "font:600 16px ui-monospace,monospace;display:inline-block;min-width:5.5em");
+    this.watchBtn = el("button", { type: "button", textContent: "Start" }, BUTTON);
+    const reset = el("button", { type: "button", textContent: "Reset" }, BUTTON);
+    this.watchBtn.addEventListener("click", () => {
+      this.watch.running = !this.watch.running;
+      this.watch.last = this.result ? this.result.t[this.stage.frame] : null;
+      this.watchBtn.textContent = this.watch.running ? "Stop" : "Start";
+      this.watchOut.dataset.running = this.watch.running ? "1" : "0";
+    });
+    reset.addEventListener("click", () => {
+      this.watch.elapsed = 0;
+      this.watch.last = this.result ? this.result.t[this.stage.frame] : null;
+      this.#showWatch();
+    });
+    const row = el("div", {}, "display:flex;align-items:center;gap:4px;flex-wrap:wrap");
+    row.append(this.watchOut, this.watchBtn, reset);
+    box.append(row);
+
+    box.append(el("p", { textContent: "Period timer" }, `${HEAD};margin-top:8px`));
+    this.periodQ = el("select", { ariaLabel: "coordinate to time" }, "font-size:12px");
+    this.periodQ.setAttribute("aria-label", "coordinate to time");
+    this.periodQ.addEventListener("change", () => { this.#crossings(); this.update(this.stage.frame); });
+    this.periodOut = el("output", { id: "period", textContent: "–" }, "font:600 14px ui-monospace,monospace;margin-left:6px");
+    const prow = el("div", {}, "display:flex;align-items:center;flex-wrap:wrap");
+    prow.append(this.periodQ, this.periodOut);
+    this.periodNote = el("p", {}, SMALL);
+    box.append(prow, this.periodNote);
+    this.box.append(box);
+  }
+
+  #showWatch() {
+    this.watchOut.textContent = `${this.watch.elapsed.toFixed(2)} s`;
+    this.watchOut.dataset.elapsed = String(this.watch.elapsed);
+  }
+
+  /** Upward crossings of the chosen coordinate through its mean over the run, interpolated. */
+  #crossings() {
+    const r = this.result, name = this.periodQ.value;
+    this.ups = [];
+    if (!r || !r.q || !r.q[name]) return;
+    const q = r.q[name], t = r.t;
+    const mean = q.reduce((s, v) => s + v, 0) / q.length;
+    this.mean = mean;
+    for (let k = 0; k + 1 < q.length; k++) {
+      if (q[k] < mean && q[k + 1] >= mean) {
+        const f = (mean - q[k]) / (q[k + 1] - q[k]);
+        this.ups.push([k + 1, t[k] + f * (t[k + 1] - t[k])]);
+      }
+    }
+  }
+
+  #updatePeriod(i) {
+    const seen = (this.ups || []).filter(([k]) => k <= i);
+    const out = this.periodOut;
+    if (seen.length < 2) {
+      out.textContent = "–";
+      delete out.dataset.period;
+    } else {
+      const period = (seen[seen.length - 1][1] - seen[0][1]) / (seen.length - 1);
+      out.textContent = `T ≈ ${period.toFixed(3)} s`;
+      out.dataset.period = String(period);
+    }
+    const small = smallOscillationPeriods();
+    const name = this.periodQ.value;
+    this.periodNote.textContent = `Counts ${name} rising through its mean over the run` +
+      (Number.isFinite(this.mean) ? ` (${this.mean.toFixed(3)})` : "") +
+      `: ${Math.max(0, seen.length - 1)} full period${seen.length === 2 ? "" : "s"} so far.` +
+      (small.length ? ` Small oscillations (equilibria): 2π/ω = ${small.map((p) => `${p.toFixed(3)} s`).join(", ")}.` : "");
+  }
+
+  // ------------------------------------------------------------------ gravity presets
+  #gravityPanel() {
+    this.gravityBox = el("div", { className: "gravity-presets" }, `${BOX};flex:1 1 200px`);
+    this.box.append(this.gravityBox);
+  }
+
+  #buildGravity() {
+    const box = this.gravityBox;
+    const g = this.spec.gravity;
+    const name = g && typeof g.acceleration === "string" && /^[A-Za-z_]\w*$/.test(g.acceleration.trim())
+      ? g.acceleration.trim() : null;
+    box.replaceChildren(el("p", { textContent: "Gravity" }, HEAD));
+    box.hidden = !g;
+    if (!g) return;
+    if (!name || !document.getElementById(`n-${name}`)) {
+      box.append(el("p", { textContent: `g is ${g.acceleration} here, not a parameter: no presets.` }, SMALL));
+      return;
+    }
+    this.gravityName = name;
+    const row = el("div", {}, "display:flex;flex-wrap:wrap;gap:4px");
+    for (const [planet, value] of GRAVITY) {
+      const b = el("button", { type: "button", textContent: `${planet} ${value ? value : ""}`.trim() }, BUTTON);
+      b.dataset.g = String(value);
+      b.addEventListener("click", () => this.setGravity(value));
+      row.append(b);
+    }
+    box.append(row, el("p", { textContent: `Sets the parameter ${name} (m/s²) and runs again.` }, SMALL));
+    this.#markGravity();
+  }
+
+  /** Put `value` in the gravity parameter's number box and fire 'input' and 'change' as typing
+   * would: the page's own controls then move the slider, update the link and re-run. */
+  setGravity(value) {
+    const input = document.getElementById(`n-${this.gravityName}`);
+    if (!input) return;
+    input.value = String(value);
+    input.dispatchEvent(new Event("input", { bubbles: true }));
+    input.dispatchEvent(new Event("change", { bubbles: true }));
+    this.#markGravity();
+  }
+
+  #markGravity() {
+    const input = document.getElementById(`n-${this.gravityName}`);
+    const now = input ? Number(input.value) : NaN;
+    for (const b of this.gravityBox.querySelectorAll("button")) {
+      const on = Math.abs(Number(b.dataset.g) - now) < 1e-9;
+      b.setAttribute("aria-pressed", String(on));
+      b.style.fontWeight = on ? "700" : "";
+    }
+  }
+
+  // ------------------------------------------------------------------ fed by the stage
+  setResult(spec, result) {
+    const fresh = spec !== this.spec;
+    this.spec = spec;
+    this.result = result;
+    this.#buildBars();
+    if (fresh) {
+      const keep = this.periodQ.value;
+      this.periodQ.replaceChildren(...spec.coordinates.map((q) => new Option(q, q)));
+      if (spec.coordinates.includes(keep)) this.periodQ.value = keep;
+      this.#buildGravity();
+    } else if (this.gravityName) this.#markGravity();
+    this.#crossings();
+    this.watch.last = null;
+  }
+
+  /** The sample on screen changed (called by the stage every frame it draws). */
+  update(i) {
+    const r = this.result;
+    if (!r || !r.t.length) return;
+    const t = r.t[i];
+    if (this.watch.running) {
+      // the simulation clock: a jump back (the run looped, or the slider went back) adds nothing
+      if (this.watch.last !== null && t > this.watch.last) this.watch.elapsed += t - this.watch.last;
+      this.watch.last = t;
+    }
+    this.#showWatch();
+    this.#updateBars(i);
+    if (i !== this.shownAt) this.#updatePeriod(i);
+    this.shownAt = i;
+    this.box.dataset.t = String(t);
+    this.box.dataset.frame = String(i);
+  }
+}
+
+/** The small-oscillation periods 2π/ω of the first stable equilibrium the page lists (read from
+ * its equilibria panel, whose frequencies may already be typeset by MathJax). */
+function smallOscillationPeriods() {
+  const li = [...document.querySelectorAll("#equilibria li")].find((x) => x.querySelector(".tag.stable"));
+  const freq = li && li.querySelector(".freq");
+  if (!freq) return [];
+  let text = freq.textContent || "";
+  const doc = window.MathJax && window.MathJax.startup && window.MathJax.startup.document;
+  if (doc && doc.getMathItemsWithin) {
+    try { text = doc.getMathItemsWithin(freq).map((m) => m.math).join(" ") + " " + text; } catch { /* plain text it is */ }
+  }
+  const m = text.match(/(?:ω|\\omega)\s*=\s*([-\d.eE+,\s]+)/);
+  if (!m) return [];
+  return m[1].split(",").map(Number).filter((w) => Number.isFinite(w) && w > 0).map((w) => (2 * Math.PI) / w);
+}
