@@ -416,12 +416,18 @@ def _summary(
         )
     if parted_at is not None:
         parts.append(f"it parts visibly from the true motion at t = {parted_at:.2f} s")
-    change = energy["energy_change"]
+    change, most = energy["energy_change"], energy["energy_change_max"]
     if abs(change) >= 1e-3:
         verb = "creates" if change > 0 else "destroys"
         parts.append(
             f"measured with the true energy, your model {verb} {abs(change):.0%} of the motion's "
             f"energy in {energy['energy_until']:.2f} s"
+            + (f" (up to {most:.0%} along the way)" if most > 1.5 * abs(change) else "")
+        )
+    elif most >= 1e-3:
+        parts.append(
+            f"measured with the true energy, your model's energy swings by up to {most:.0%} "
+            "of the motion's energy"
         )
     if not parts:
         return "Your answer predicts the same motion as the derivation."

@@ -78,7 +78,8 @@ function yourTurn(stepId, target, coordinates) {
       aria-label="your answer"><button type="button" class="check">Check</button>
       <button type="button" class="reveal">Show answer</button></div>
       <div class="result" aria-live="polite" aria-atomic="true"><div class="echo"></div>
-      <p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div></div>`;
+      <p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div></div>
+      <div class="predict"></div>`;
     box.querySelector(".prompt").textContent = prompt;
     const input = box.querySelector("input");
     const result = box.querySelector(".result");
@@ -97,14 +98,18 @@ function yourTurn(stepId, target, coordinates) {
         // each feedback sentence carries its math as $…$ (LaTeX), rendered by MathJax
         box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: inlineMath(f) })));
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
+        offerPrediction(box.querySelector(".predict"), r.correct ? null : body);
         await typeset([result]);
+        result.dataset.checked = String(mine); // settled and typeset (tests wait on it)
       } catch (err) {
         if (mine !== asked) return;
         // an answer that could not be read replaces the previous answer's result, never sits
         // beside it (a stale "✔ Correct" under a new parse error)
         for (const part of [".echo", ".expected"]) box.querySelector(part).textContent = "";
         box.querySelector(".feedback").replaceChildren();
+        offerPrediction(box.querySelector(".predict"), null);
         showError(verdict, err.message);
+        result.dataset.checked = String(mine);
       }
     };
     box.querySelector(".check").addEventListener("click", () => ask(false));
@@ -130,4 +135,22 @@ function showError(verdict, message) {
   const code = el("code", { className: "typed" }, before,
     el("mark", { textContent: "▸", title: `character ${at}` }), after);
   verdict.replaceChildren(`${what} at character ${at}: `, code);
+}
+
+/** Quantities whose wrong answer is a model of its own that can be integrated (predict.js). */
+const PREDICTS = new Set(["eom", "accel", "T", "V", "L", "Q"]);
+
+/** After a wrong answer, a button that integrates it beside the true motion; cleared otherwise. */
+function offerPrediction(area, request) {
+  area.replaceChildren();
+  if (!request || !PREDICTS.has(request.quantity)) return;
+  const button = el("button", { type: "button", className: "predict-open", textContent: "See what your answer predicts" });
+  const out = el("div", { className: "predict-out" });
+  button.addEventListener("click", async () => {
+    button.disabled = true;
+    const { showPrediction } = await import("./predict.js");
+    await showPrediction(out, request);
+    button.disabled = false;
+  });
+  area.append(button, out);
 }
