@@ -107,7 +107,12 @@ def read_answer(
     rewritten text the parser saw.
     """
     model = d.model
-    text, where = to_convention_mapped(answer, model.coordinate_names, model.names.keys() | {"t"})
+    try:
+        text, where = to_convention_mapped(
+            answer, model.coordinate_names, model.names.keys() | {"t"}
+        )
+    except ExprError as exc:  # the notation rewrite's positions already count what was typed
+        raise _pointed(exc.message, answer, exc.position) from None
     names = answer_names(d)
 
     def read(start: int, end: int) -> sp.Expr:
@@ -179,6 +184,7 @@ class _Judge:
         # what the units of every term should be: the quantity's, or for an equation of motion
         # the units of the student's own scaling of it (set in _eom)
         self.reference = expected
+        self.scale: sp.Expr = sp.S.One  # the student's scaling of an equation of motion
         rng = random.Random(0)
         self.states = [self._state(rng) for _ in range(SAMPLES)]
         # The same motion states at one set of parameters: for "constant" and "multiple of",
@@ -293,7 +299,8 @@ class _Judge:
                 f"Read as the derived equation multiplied by {inline(scale)} (scaling an equation "
                 "changes nothing); against that:"
             )
-            expected = sp.expand(expected * scale)
+            expected = expected * scale
+            self.scale = scale
         self.reference = expected
         self._diagnose(given, expected, fb)
 
@@ -323,7 +330,8 @@ class _Judge:
                 "should be."
             )
         else:
-            fb += self._terms(given, expected)
+            paired = self._paired(given)
+            fb += self._terms(given, expected) if paired is None else paired
             fb += self._slips(given, expected)
         fb += self._units(given)
         if not fb:
@@ -374,6 +382,58 @@ class _Judge:
         if not from_speeds:
             return ""
         return ": the part that comes from " + " and ".join(inline(v) for v in from_speeds)
+
+    def _surface(self, expr: sp.Expr) -> list[sp.Expr]:
+        """The terms as written (cos(θ₁ − θ₂) kept whole), a common factor multiplied in."""
+        terms = list(sp.Add.make_args(expr))
+        while len(terms) == 1 and isinstance(terms[0], sp.Mul):
+            sums = [f for f in terms[0].args if isinstance(f, sp.Add)]
+            if len(sums) != 1:
+                break
+            rest = terms[0] / sums[0]
+            terms = [rest * a for a in sums[0].args]
+        return terms
+
+    def _paired(self, given: sp.Expr) -> list[str] | None:
+        """Feedback term by term as the terms are written, when each term of the answer is a
+        fixed multiple of its own term of the derived result (a sign, a factor): names
+        'the l₁ l₂ m₂ cos(θ₁ − θ₂) θ̇₁ θ̇₂ term' rather than its expanded pieces. None when the
+        terms do not pair up one to one (the canonical comparison then finds what differs)."""
+        derived = [
+            self.scale * e for e in self._surface(tidy(self.expected, self.m, factor_whole=False))
+        ]
+        written = self._surface(given)
+        if not 1 < len(derived) <= 12 or len(written) != len(derived):
+            return None
+        values = {id(e): self.values(e) for e in (*derived, *written)}
+        fb, free = [], list(written)
+        for e in derived:
+            match = next((g for g in free if self._fixed_ratio(values[id(g)], values[id(e)])), None)
+            if match is None:
+                return None
+            free.remove(match)
+            ratio = self._fixed_ratio(values[id(match)], values[id(e)])
+            if ratio == -1:
+                fb.append(f"Sign error in the {self._show(e)} term{self._moved_term(match)}.")
+            elif ratio != 1:
+                fb.append(f"The term {self._show(e)} is off by a factor of {inline(ratio)}.")
+        return fb
+
+    @staticmethod
+    def _fixed_ratio(a: list[complex], b: list[complex]) -> sp.Expr | None:
+        """a/b when it is one number at every sampled state (parameters varied too)."""
+        ratios = [x / y for x, y in zip(a, b, strict=True) if abs(y) > 1e-12]
+        if len(ratios) < len(a) // 2 or any(
+            abs(r - ratios[0]) > 1e-8 * max(1, abs(ratios[0])) for r in ratios
+        ):
+            return None
+        return sp.nsimplify(round(ratios[0].real, 10), rational=True) or None
+
+    def _moved_term(self, term: sp.Expr) -> str:
+        """A term written right of '=' shows up negated in lhs − rhs."""
+        if self.moved == 0 or -term not in sp.Add.make_args(self.moved):
+            return ""
+        return " (a term carried across '=' changes its sign)"
 
     def _moved(self, mono: sp.Expr) -> str:
         """Why a term of an equation may have its sign flipped: it was carried across '='."""

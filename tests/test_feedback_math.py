@@ -56,6 +56,9 @@ def error_of(answer, quantity="T", scene="simple_pendulum", coordinate=None):
         ("2*(m+)", 4, "missing after '+'"),
         # '^^': the second caret at 2 (rewritten to '**') has nothing before it
         ("m^^2", 2, "needs a term"),
+        # refused by the notation rewrite itself: a prime after a number, a stray character
+        ("2 ' theta", 2, "prime"),
+        ("θ̇ m $ l", 5, "'$'"),  # θ and its dot are two characters: 0 and 1
     ],
 )
 def test_parse_errors_point_at_the_character_typed(answer, position, says):
@@ -183,3 +186,32 @@ def test_accel_may_be_written_with_its_left_side():
     assert verdict("simple_pendulum", "accel", "theta'' = -g/l sin(theta)", "theta").correct
     error = error_of("theta_dot = -g/l sin(theta)", "accel", coordinate="theta")
     assert "theta_ddot = ..." in error.message and error.position == 10
+
+
+def test_a_term_is_named_as_written_not_in_expanded_pieces():
+    """The double pendulum's coupling term m₂ l₁ l₂ cos(θ₁ − θ₂) θ̇₁ θ̇₂ with its sign flipped is
+    one sign error in that term, not two in cos θ₁ cos θ₂ and sin θ₁ sin θ₂ (Taylor eq. 11.41)."""
+    v = verdict(
+        "double_pendulum",
+        "T",
+        "(m1+m2)/2 l1^2 theta1'^2 + m2/2 l2^2 theta2'^2"
+        " - m2 l1 l2 cos(theta1 - theta2) theta1' theta2'",
+    )
+    assert not v.correct
+    assert len(v.feedback) == 1, v.feedback
+    assert "Sign error in the" in v.feedback[0]
+    assert r"\cos{\left(\theta_{1} - \theta_{2} \right)}" in v.feedback[0]
+
+
+def test_eom_terms_carried_across_are_each_named():
+    """(m₁+m₂) l₁ θ̈₁ + m₂ l₂ cos(θ₁−θ₂) θ̈₂ = m₂ l₂ sin(θ₁−θ₂) θ̇₂² + (m₁+m₂) g sin θ₁: both
+    right-hand terms should have changed sign when moved."""
+    v = verdict(
+        "double_pendulum",
+        "eom",
+        "(m1+m2) l1 theta1'' + m2 l2 cos(theta1-theta2) theta2''"
+        " = m2 l2 sin(theta1-theta2) theta2'^2 + (m1+m2) g sin(theta1)",
+        "theta1",
+    )
+    moved = [f for f in v.feedback if "carried across '='" in f]
+    assert len(moved) == 2, v.feedback

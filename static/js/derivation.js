@@ -128,13 +128,16 @@ function showError(verdict, message) {
   verdict.className = "verdict bad";
   const m = /^(.*) \(at character (\d+): (.*)⟨here⟩(.*)\)$/s.exec(message);
   if (!m) {
-    verdict.textContent = message;
+    verdict.textContent = inlineMath(message);
+    typeset([verdict]);
     return;
   }
   const [, what, at, before, after] = m;
+  // the typed text stays text (never math, whatever it holds); the message's own math renders
   const code = el("code", { className: "typed" }, before,
     el("mark", { textContent: "▸", title: `character ${at}` }), after);
-  verdict.replaceChildren(`${what} at character ${at}: `, code);
+  verdict.replaceChildren(el("span", { textContent: `${inlineMath(what)} at character ${at}: ` }), code);
+  typeset([verdict.firstChild]);
 }
 
 /** Quantities whose wrong answer is a model of its own that can be integrated (predict.js). */

@@ -52,10 +52,14 @@ async function sketch(svg, target, parameters, spec, q) {
 export async function showEquilibria(box, target, parameters, startAt, spec = null) {
   try {
     const r = await postJSON("/api/v1/equilibria", { ...target, parameters });
-    if (!r.equilibria.length) {
-      box.replaceChildren(Object.assign(document.createElement("p"), {
-        className: "muted", textContent: r.warnings[0] || "No equilibrium at these parameters.",
+    // every warning shown (a capped list, dry friction, a drive), its math ($…$) rendered
+    const notes = (r.warnings.length || r.equilibria.length ? r.warnings : ["No equilibrium at these parameters."])
+      .map((w) => Object.assign(document.createElement("p"), {
+        className: "muted eq-warning", textContent: w.replace(/\$([^$]+)\$/g, "\\($1\\)"),
       }));
+    if (!r.equilibria.length) {
+      box.replaceChildren(...notes);
+      await typeset(notes);
       return;
     }
     const ul = document.createElement("ul");
@@ -109,8 +113,8 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       });
       ul.append(li);
     }
-    box.replaceChildren(ul);
-    await typeset([ul]);
+    box.replaceChildren(ul, ...notes);
+    await typeset([ul, ...notes]);
   } catch (err) {
     box.replaceChildren(Object.assign(document.createElement("p"), { className: "muted", textContent: err.message }));
   }

@@ -40,7 +40,8 @@ export async function showPrediction(box, request) {
     render(box, spec, params, r);
     await typeset([box]);
   } catch (err) {
-    box.replaceChildren(el("p", { className: "verdict bad", textContent: err.message }));
+    box.replaceChildren(el("p", { className: "verdict bad", textContent: inlineMath(err.message) }));
+    await typeset([box]);
   }
 }
 
