@@ -52,9 +52,16 @@ def scene_page(request: Request, scene_id: str) -> HTMLResponse:
             request, "404.html", {"what": f"There is no scene '{scene_id}'."}, status_code=404
         )
     entry = next(s for s in list_scenes() if s["id"] == scene_id)
-    return _page(
+    page = _page(
         request, "scene.html", scene_id=scene_id, title=entry["title"], summary=entry["summary"]
     )
+    # The page's script asks for these first; the browser fetches them while it is still
+    # parsing MathJax and the modules, and the script's fetch() finds them waiting.
+    page.headers["Link"] = ", ".join(
+        f"<{url}>; rel=preload; as=fetch; crossorigin"
+        for url in (f"/api/v1/scenes/{scene_id}", f"/api/v1/scenes/{scene_id}/live")
+    )
+    return page
 
 
 @router.get("/editor", response_class=HTMLResponse)

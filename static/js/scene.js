@@ -206,8 +206,10 @@ class SceneView {
       $("canvas").dataset.lastQ = JSON.stringify(last);
       $("canvas").dataset.run = String(id);
       showStop([a, b]);
-      this.#plot();
       this.fbd(true);
+      // The plots after the motion's next frame is painted: plotly's first drawing takes a few
+      // hundred ms of the main thread, which the animation should not wait behind.
+      requestAnimationFrame(() => setTimeout(() => this.#plot(), 0));
     } catch (err) {
       if (id !== this.runs) return;
       showWarnings([`The simulation failed: ${err.message}`]);
@@ -408,7 +410,12 @@ class SceneView {
     showWarningsBelow(this.derivation.warnings);
     this.lecture.apply();
     if (this.result) this.fbd(true);
-    await typeset([steps]);
+    // One step at a time with a frame between: typesetting the whole derivation at once holds the
+    // main thread for half a second, during which the animation could not start or move.
+    for (const item of [...steps.children]) {
+      await typeset([item]);
+      await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+    }
     steps.dataset.typeset = "1";
   }
 
