@@ -130,6 +130,8 @@ export class Stage {
     if (note) shapes.push({ t: "text", at: [10, 8 + font], text: note, color: "#868e96", size: font });
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
+    const v = this.view; // the camera, for tests that check where things are drawn
+    canvas.dataset.camera = JSON.stringify({ w: v.w, h: v.h, scale: v.scale, center: v.center, yaw: v.yaw, pitch: v.pitch, camera: v.camera, is3D: v.is3D });
     canvas.dataset.pieces = [...new Set(shapes.map((s) => s.piece).filter(Boolean))].sort().join(" ");
     if (this.instruments) this.instruments.update(this.frame);
   }

@@ -81,7 +81,11 @@ export class Instruments {
     const r = this.result, scrub = document.getElementById("scrub");
     if (!r || !scrub || r.t.length < 2) return;
     const end = r.t[r.t.length - 1];
-    const target = Math.max(0, Math.min(r.t.length - 1, this.stage.frame + by));
+    // keys pressed faster than frames are drawn step on from the last step, not the stale frame
+    const recent = this.stepped && performance.now() - this.stepped.at < 300;
+    const from = recent ? this.stepped.to : this.stage.frame;
+    const target = Math.max(0, Math.min(r.t.length - 1, from + by));
+    this.stepped = { to: target, at: performance.now() };
     scrub.step = "any";
     scrub.value = String(end > 0 ? (1000 * r.t[target]) / end : 0);
     scrub.dispatchEvent(new Event("input", { bubbles: true }));
@@ -127,6 +131,7 @@ export class Instruments {
       parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="142" font-size="11" fill="${color}" text-anchor="middle" font-style="italic">${label}</text>`);
     });
     this.svg.innerHTML = parts.join("");
+    Object.assign(this.svg.dataset, { lo: String(lo), hi: String(hi) });
     this.rects = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`rect[data-key="${k}"]`)]));
     this.labels = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`text[data-value-of="${k}"]`)]));
     const works = shown.filter(([, , , w]) => w).map(([, l]) => l);
@@ -160,10 +165,13 @@ export class Instruments {
     this.watchBtn = el("button", { type: "button", textContent: "Start" }, BUTTON);
     const reset = el("button", { type: "button", textContent: "Reset" }, BUTTON);
     this.watchBtn.addEventListener("click", () => {
+      const t = this.result ? this.result.t[this.stage.frame] : null;
+      if (this.watch.running) this.#tick(t); // up to the sample on screen now
       this.watch.running = !this.watch.running;
-      this.watch.last = this.result ? this.result.t[this.stage.frame] : null;
+      this.watch.last = t;
       this.watchBtn.textContent = this.watch.running ? "Stop" : "Start";
-      this.watchOut.dataset.running = this.watch.running ? "1" : "0";
+      Object.assign(this.watchOut.dataset, { running: this.watch.running ? "1" : "0", [this.watch.running ? "from" : "to"]: String(t) });
+      this.#showWatch();
     });
     reset.addEventListener("click", () => {
       this.watch.elapsed = 0;
@@ -184,6 +192,13 @@ export class Instruments {
     this.periodNote = el("p", {}, SMALL);
     box.append(prow, this.periodNote);
     this.box.append(box);
+  }
+
+  /** The simulation clock moved to t: a jump back (the run looped, the slider went back) adds
+   * nothing. */
+  #tick(t) {
+    if (this.watch.last !== null && t > this.watch.last) this.watch.elapsed += t - this.watch.last;
+    this.watch.last = t;
   }
 
   #showWatch() {
@@ -290,6 +305,7 @@ export class Instruments {
       this.#buildGravity();
     } else if (this.gravityName) this.#markGravity();
     this.#crossings();
+    this.shownAt = null; // a new run: the period is read again even at the same sample
     this.watch.last = null;
   }
 
@@ -298,11 +314,7 @@ export class Instruments {
     const r = this.result;
     if (!r || !r.t.length) return;
     const t = r.t[i];
-    if (this.watch.running) {
-      // the simulation clock: a jump back (the run looped, or the slider went back) adds nothing
-      if (this.watch.last !== null && t > this.watch.last) this.watch.elapsed += t - this.watch.last;
-      this.watch.last = t;
-    }
+    if (this.watch.running) this.#tick(t);
     this.#showWatch();
     this.#updateBars(i);
     if (i !== this.shownAt) this.#updatePeriod(i);

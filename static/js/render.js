@@ -87,7 +87,7 @@ export function toSVG(shapes) {
   return shapes.map((s) => {
     const stroke = s.color ? ` stroke="${s.color}" stroke-width="${s.width ?? 1}"` : "";
     const fill = ` fill="${s.fill || "none"}"`;
-    const extra = `${s.alpha !== undefined ? ` opacity="${s.alpha.toFixed(2)}"` : ""}${s.dash ? ` stroke-dasharray="${s.dash.join(" ")}"` : ""}${s.cap ? ` stroke-linecap="${s.cap}"` : ""}`;
+    const extra = `${s.piece ? ` data-piece="${s.piece}"` : ""}${s.alpha !== undefined ? ` opacity="${s.alpha.toFixed(2)}"` : ""}${s.dash ? ` stroke-dasharray="${s.dash.join(" ")}"` : ""}${s.cap ? ` stroke-linecap="${s.cap}"` : ""}`;
     if (s.t === "line") {
       return `<line x1="${num(s.a[0])}" y1="${num(s.a[1])}" x2="${num(s.b[0])}" y2="${num(s.b[1])}"${stroke}${extra}/>`;
     }

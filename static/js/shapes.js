@@ -204,7 +204,7 @@ function hoop(geom, view, h, i, out) {
   out.push({ t: "poly", pts: circle3(view, c, axis(h.axes[0]), axis(h.axes[1]), h.radius), color: "#868e96", width: 3, alpha: 0.9, piece: "hoop" });
   out.push({ t: "circle", c: view.project(c).slice(0, 2), r: 3, fill: "#868e96" });
   const spin = spinAxis(geom, h.frame);
-  if (spin !== null) spinMarks(geom, view, h.frame, spin, c, -1.25 * h.radius, 1.3 * h.radius, 0.18 * h.radius, i, out);
+  if (spin !== null) spinMarks(geom, view, h.frame, spin, c, -1.25 * h.radius, 1.35 * h.radius, 0.25 * h.radius, i, out);
 }
 
 /** The curve a bead rides on (swept from its position function), turning with its frame. */
@@ -218,7 +218,7 @@ function wire(geom, view, w, i, out) {
   const along = w.local.map((p) => p[axis]);
   const lo = Math.min(0, ...along), hi = Math.max(0, ...along);
   const size = Math.max(hi - lo, ...w.local.map((p) => Math.hypot(...p.filter((_, k) => k !== axis))), 1e-6);
-  spinMarks(geom, view, w.frame, axis, geom.at(w.anchor, i), lo - 0.15 * size, hi + 0.2 * size, 0.12 * size, i, out);
+  spinMarks(geom, view, w.frame, axis, geom.at(w.anchor, i), lo - 0.15 * size, hi + 0.25 * size, 0.15 * size, i, out);
 }
 
 /** The index (0, 1, 2) of the axis a frame turns about, when it turns; else null. */
@@ -242,7 +242,7 @@ function spinMarks(geom, view, frame, axis, origin, lo, hi, r, i, out) {
     const B = geom.axesAt(frame, j);
     sense = Math.sign(dot(sub(B[(axis + 1) % 3], e1), e2) * (j > i ? 1 : -1)) || 1;
   }
-  const c = add(origin, mul(e, hi - 0.3 * r));
+  const c = add(origin, mul(e, hi - 0.4 * r));
   const arc = [];
   for (let k = 0; k <= 24; k++) {
     const a = sense * (0.25 + (1.4 * Math.PI * k) / 24);
@@ -303,7 +303,7 @@ function support(geom, view, s, i, out) {
   const d = view.direction(geom.at(s.point, i), s.dir);
   if (!d[0] && !d[1]) return;
   const n = [-d[1], d[0]], half = 20;
-  out.push({ t: "line", a: [x - n[0] * half, y - n[1] * half], b: [x + n[0] * half, y + n[1] * half], color: INK, width: 2.5 });
+  out.push({ t: "line", a: [x - n[0] * half, y - n[1] * half], b: [x + n[0] * half, y + n[1] * half], color: INK, width: 2.5, piece: "support" });
   for (let k = -half + 4; k <= half; k += 6) {
     const px = x + n[0] * k, py = y + n[1] * k;
     out.push({ t: "line", a: [px, py], b: [px - d[0] * 7 - n[0] * 5, py - d[1] * 7 - n[1] * 5], color: "#868e96", width: 1 });
