@@ -221,6 +221,7 @@ async function fitOne(box) {
   if (!width || box.dataset.fitWidth === String(width)) return;
   const original = box.dataset.latex;
   box.classList.remove("scrolls");
+  box.removeAttribute("tabindex");
   box.style.removeProperty("--fit-scale");
   if (original && box.dataset.broken) { // wider again: try the line as the engine wrote it
     await show(box, original);
@@ -257,6 +258,7 @@ function scaleOrScroll(box) {
   box.style.removeProperty("--fit-scale");
   box.classList.remove("scaled");
   box.classList.add("scrolls");
+  box.tabIndex = 0; // a box that scrolls is reached by the keyboard too (arrow keys scroll it)
 }
 
 let queue = Promise.resolve();

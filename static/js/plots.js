@@ -2,16 +2,36 @@
 // work W_NC of non-conservative forces) against time, with plotly served by the app (no CDN).
 // In compare mode the energy plot shows both runs' energy error instead.
 
-const CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["select2d", "lasso2d"] };
+// No "share to Plotly Cloud" (plotly.js 4 offers it by default: an upload off the machine), no logo,
+// no selection tools (nothing here uses a selection). The toolbar's buttons are kept out of the
+// tab order by page.js.
+export const CONFIG = {
+  responsive: true, displaylogo: false, showSendToCloud: false, showEditInChartStudio: false,
+  modeBarButtonsToRemove: ["sendChartToCloud", "sendDataToCloud", "select2d", "lasso2d"],
+};
 
-function layout(title, x, y, lecture) {
+/**
+ * Work or energy changes that are all at the level of rounding and integration error next to the
+ * scene's energies (|w| ≤ 1e-7 × scale: a conservative run at the default tolerance drifts by
+ * ~5e-9 of its energy) are not plotted as they are: plotly would stretch the axis to nJ or pJ and
+ * draw the noise as a signal.
+ */
+export const NEGLIGIBLE = 1e-7;
+export const atRoundingLevel = (values, scale) =>
+  values.every((v) => !Number.isFinite(v) || Math.abs(v) <= NEGLIGIBLE * Math.max(scale, 1e-300));
+export const energyScale = (energy) =>
+  Math.max(...["T", "V", "E"].flatMap((k) => (energy[k] || []).map((v) => Math.abs(v) || 0)), 0);
+
+export function layout(title, x, y, lecture) {
   const ink = lecture ? "#f1f3f5" : "#1d2430";
   const grid = lecture ? "#333" : "#e9ecef";
   return {
-    title: { text: title, font: { size: lecture ? 20 : 14 } },
-    margin: { l: 62, r: 14, t: 40, b: 48 },
-    legend: { orientation: "h", y: -0.3, x: 0, font: { size: lecture ? 14 : 11 } },
-    font: { size: lecture ? 16 : 12, color: ink },
+    // a title is kept short enough for a plot a third of the page wide, and a second line (<br>)
+    // gets room (automargin) instead of being clipped; the legend sits below the x-axis title
+    title: { text: title, font: { size: lecture ? 22 : 14 }, automargin: true, x: 0.02, xanchor: "left" },
+    margin: { l: 62, r: 14, t: lecture ? 56 : 44, b: lecture ? 64 : 52 },
+    legend: { orientation: "h", yanchor: "top", y: -0.24, x: 0, font: { size: lecture ? 20 : 11 } },
+    font: { size: lecture ? 20 : 12, color: ink },
     paper_bgcolor: "rgba(0,0,0,0)",
     plot_bgcolor: "rgba(0,0,0,0)",
     xaxis: { title: { text: x }, gridcolor: grid, zerolinecolor: grid },
@@ -59,7 +79,7 @@ export function plotRun({ a, b, labels, spec, phase, lecture }) {
       { x: t, y: e.V, name: "V", mode: "lines" },
       { x: t, y: e.E, name: "E = T + V", mode: "lines", line: { width: 3 } },
     ];
-    if (e.W_nc.some((w) => Math.abs(w) > 1e-12)) {
+    if (!atRoundingLevel(e.W_nc, energyScale(e))) {
       energy.push({ x: t, y: e.W_nc, name: "W_NC", mode: "lines", line: { dash: "dot" } });
     }
   }

@@ -5,8 +5,9 @@
 // result Newton's method gives and Lagrange's hides (a pendulum's tension, where a string would
 // go slack).
 
+import { atRoundingLevel, CONFIG, energyScale } from "./plots.js";
+
 const $ = (id) => document.getElementById(id);
-const CONFIG = { responsive: true, displaylogo: false };
 
 function fmt(x) {
   const a = Math.abs(x);
@@ -63,23 +64,50 @@ export function showWork(run, { lecture = false } = {}) {
   table.dataset.driven = driven ? "1" : "0";
   if (typeof window.Plotly === "undefined") return;
   const ink = lecture ? "#f1f3f5" : "#1d2430";
-  const base = { margin: { l: 60, r: 12, t: 40, b: 46 }, paper_bgcolor: "rgba(0,0,0,0)",
-    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 16 : 12 },
-    legend: { orientation: "h", y: -0.3 } };
+  const base = { margin: { l: 60, r: 12, t: lecture ? 60 : 48, b: lecture ? 64 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
+    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 20 : 12 },
+    legend: { orientation: "h", yanchor: "top", y: -0.24 } };
+  // titles of one short line: plotly clips a title longer than its plot, and a second line too
+  const title = (text) => ({ text, font: { size: lecture ? 22 : 14 }, x: 0.02, xanchor: "left" });
+  const top = () => base.margin;
   const span = t.slice(i, j + 1);
   const traces = Object.entries(run.work.non_conservative).map(([k, w]) => ({
     x: span, y: w.slice(i, j + 1).map((v) => v - w[i]), name: `W ${label(k)}`, stackgroup: "nc", mode: "none" }));
   if (driven) traces.push({ x: span, y: e.W_drive.slice(i, j + 1).map((v) => v - e.W_drive[i]), name: "W drive", stackgroup: "nc", mode: "none" });
   traces.push({ x: span, y: span.map((_, k) => e.T[i + k] - e.T[i] + e.V[i + k] - e.V[i]), name: "ΔT + ΔV",
     mode: "lines", line: { color: ink, width: 2, dash: "dot" } });
-  window.Plotly.react("plot-work", traces, { ...base, title: { text: driven ? "W of each non-conservative force and of the drive (stacked), and ΔT + ΔV" : "W of each non-conservative force (stacked) and ΔT + ΔV" },
-    xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "J" } } }, CONFIG);
+  // A conservative scene: no force does work and ΔT + ΔV is zero up to rounding and integration
+  // error. Plotted as it is, the axis would zoom to nJ and show noise; it is drawn flat at 0 on an
+  // axis of the scene's energy scale, saying so and how large the largest value was.
+  const energy = energyScale(e);
+  const rounding = traces.every((tr) => atRoundingLevel(tr.y, energy));
+  const yaxis = { title: { text: "J" }, zeroline: true };
+  const annotations = [];
+  if (rounding) {
+    const largest = Math.max(...traces.flatMap((tr) => tr.y.map(Math.abs)));
+    for (const tr of traces) tr.y = tr.y.map(() => 0);
+    const r = Math.max(energy, 1e-12) * 0.1;
+    Object.assign(yaxis, { range: [-r, r], autorange: false });
+    annotations.push({ text: `W<sup>NC</sup> = ΔT + ΔV = 0 within rounding<br>(largest |value| ${largest.toExponential(1)} J)`, showarrow: false,
+      xref: "paper", yref: "paper", x: 0.5, y: 0.62, font: { size: lecture ? 22 : 14, color: ink } });
+  }
+  $("plot-work").dataset.rounding = rounding ? "1" : "0";
+  const workTitle = driven ? "W of forces and drive (stacked), ΔT + ΔV"
+    : traces.length > 1 ? "W of non-conservative forces (stacked), ΔT + ΔV" : "W<sup>NC</sup> and ΔT + ΔV";
+  window.Plotly.react("plot-work", traces, { ...base, margin: top(workTitle), title: title(workTitle), annotations,
+    xaxis: { title: { text: "t (s)" } }, yaxis }, CONFIG);
+  // A body on a string or rod has a tension (which a string cannot make negative); any other
+  // constraint (a block on an incline, a bead on a hoop) a reaction of magnitude |R|.
   const forces = run.constraint_forces || {};
   const ctraces = Object.entries(forces).map(([body, f]) => f.tension
     ? { x: t, y: f.tension, name: `tension on ${body}`, mode: "lines" }
     : { x: t, y: f.x.map((x, k) => Math.hypot(x, f.y[k], f.z[k])), name: `|R| on ${body}`, mode: "lines" });
-  window.Plotly.react("plot-constraint", ctraces, { ...base,
-    title: { text: "constraint forces along the run — a negative tension means a string would go slack" },
+  const tension = Object.values(forces).some((f) => f.tension);
+  const constraintTitle = tension
+    ? "constraint forces (tension < 0: a string goes slack)"
+    : "constraint forces |R| along the run";
+  $("plot-constraint").dataset.tension = tension ? "1" : "0";
+  window.Plotly.react("plot-constraint", ctraces, { ...base, margin: top(constraintTitle), title: title(constraintTitle),
     xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
 }
 

@@ -123,6 +123,7 @@ def assert_fits(p, where: str) -> None:
     assert p.evaluate(UNCUED) == [], f"{where}: wide equations without a scroll cue"
 
 
+@pytest.mark.timeout(600)  # every built-in scene, one after another
 def test_lecture_mode_fits_the_projector_on_every_scene(server, page, sized, scenes):
     p = page.page
     for scene in scenes:
@@ -172,6 +173,7 @@ def assert_fits_page(p, where: str) -> None:
     assert not m["over"], f"{where}: beyond the right edge: {m['over']}"
 
 
+@pytest.mark.timeout(600)  # every built-in scene, one after another
 def test_phone_every_scene_fits_and_folds(server, page, sized, scenes):
     p = page.page
     sized(*PHONE)
