@@ -344,6 +344,12 @@ def predict(
             "gives no motion to integrate",
             field="answer",
         )
+    if quantity in ("T", "V", "L") and any(given.has(a) for a in m.qdd):
+        raise ExprError(
+            f"a {quantity} with accelerations in it gives equations of higher order than "
+            "Lagrange's: there is no motion from q and q̇ alone to draw",
+            field="answer",
+        )
     student_fn = compile_model(d, equations(d, quantity, given, j))
     true_fn = compile_model(d, true_rows)
     try:

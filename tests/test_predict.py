@@ -122,10 +122,12 @@ def test_a_right_answer_predicts_no_parting(quantity, coordinate, answer):
         ("(theta - 2) theta'' + g/l sin(theta) = 0", {}, "not determined"),
         ("theta''^2 + g/l sin(theta) = 0", {}, "non-linearly"),
         ("theta'' + g/l sin(theta) +", {}, "at character"),
+        ("theta_ddot/theta_dot + g/l sin(theta)", {}, "divides by zero"),  # θ̇(0) = 0
+        ("m l^2 theta''^2/2", {"quantity": "L", "coordinate": None}, "higher order"),
     ],
 )
 def test_answers_that_give_no_motion_are_422_naming_answer(answer, extra, says):
-    r = predict(answer, **extra)
+    r = predict(answer, **{"quantity": "eom", "coordinate": "theta", **extra})
     assert r.status_code == 422, r.text
     detail = r.json()["detail"][0]
     assert detail["field"] == "answer" and says in detail["message"], detail
@@ -184,3 +186,13 @@ def test_openapi_documents_the_prediction_and_its_errors_in_the_one_shape():
         assert operation["responses"][status]["content"]["application/json"]["schema"] == ref
     response = document["components"]["schemas"]["PredictResponse"]["properties"]
     assert {"true", "student", "parted_at", "energy_change", "summary"} <= set(response)
+
+
+def test_a_posted_scene_predicts_like_the_built_in_one():
+    spec = client.get("/api/v1/scenes/simple_pendulum").json()["spec"]
+    body = {"scene": spec, "quantity": "accel", "coordinate": "theta", "answer": "g/l sin θ"}
+    posted = client.post("/api/v1/check/predict", json=body)
+    assert posted.status_code == 200, posted.text
+    built_in = predict("g/l sin θ", quantity="accel").json()
+    assert posted.json()["parted_at"] == built_in["parted_at"] is not None
+    assert posted.json()["student"]["q"] == built_in["student"]["q"]
