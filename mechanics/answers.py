@@ -4,6 +4,9 @@ The rewriting works on tokens, never on evaluated text: Greek letters and primes
 `^` becomes `**`, juxtaposition becomes `*`, and a run of letters that is no known name is split
 into known names when exactly one way exists (`mgl` -> `m*g*l`). The result then goes through the
 same whitelist parser as every other expression, which reports what is still wrong, and where.
+
+`read_answer` is the one way a check or a prediction reads an answer: the rewrite, the parse, an
+equation's two sides, and every error's position carried back to the character the student typed.
 """
 
 from __future__ import annotations
@@ -11,7 +14,10 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 
-from mechanics.expr import FUNCTIONS, MAX_LENGTH, ExprError
+import sympy as sp
+
+from mechanics.derive import Derivation
+from mechanics.expr import FUNCTIONS, MAX_LENGTH, ExprError, parse
 
 GREEK = {
     "θ": "theta", "ϑ": "theta", "φ": "phi", "ϕ": "phi", "ψ": "psi", "ω": "omega", "Ω": "Omega",
@@ -168,3 +174,70 @@ def _append(out: list[tuple[str, str, int]], kind: str, value: str, at: int) -> 
         if left and right:
             out.append(("op", "*", at))
     out.append((kind, value, at))
+
+
+def answer_names(d: Derivation) -> dict[str, sp.Expr]:
+    """The names an answer may use: the scene's, t, and q̈ of every coordinate."""
+    model = d.model
+    names = dict(model.names)
+    names.update(
+        {f"{q}_ddot": qdd for q, qdd in zip(model.coordinate_names, model.qdd, strict=True)}
+    )
+    return names
+
+
+def read_answer(
+    d: Derivation, quantity: str, answer: str, j: int | None
+) -> tuple[sp.Expr, sp.Expr]:
+    """The answer as one expression, and the part of it typed right of '=' (zero without one).
+
+    An equation of motion may be written `lhs = rhs` (read as lhs − rhs = 0); q̈ may be written
+    `theta_ddot = ...`. Every ExprError points at the character the student typed, not at the
+    rewritten text the parser saw.
+    """
+    model = d.model
+    try:
+        text, where = to_convention_mapped(
+            answer, model.coordinate_names, model.names.keys() | {"t"}
+        )
+    except ExprError as exc:  # the notation rewrite's positions already count what was typed
+        raise _pointed(exc.message, answer, exc.position) from None
+    names = answer_names(d)
+
+    def read(start: int, end: int) -> sp.Expr:
+        try:
+            return parse(text[start:end], names, field="answer")
+        except ExprError as exc:
+            at = None if exc.position is None else where[min(start + exc.position, len(text))]
+            raise _pointed(exc.message, answer, at) from None
+
+    if "=" not in text:
+        return read(0, len(text)), sp.S.Zero
+    equals = text.index("=")
+    if quantity not in ("eom", "accel") or text.count("=") > 1:
+        raise _pointed(
+            "'=' belongs only in an equation of motion or q̈ = ... (once)",
+            answer,
+            where[text.rindex("=") if text.count("=") > 1 else equals],
+        )
+    lhs, rhs = read(0, equals), read(equals + 1, len(text))
+    if quantity == "eom":
+        return lhs - rhs, rhs
+    qdd = model.qdd[j]
+    if lhs == qdd or rhs == qdd:
+        return (rhs if lhs == qdd else lhs), sp.S.Zero
+    name = model.coordinate_names[j]
+    raise _pointed(f"write q̈ as '{name}_ddot = ...'", answer, where[equals])
+
+
+def _pointed(message: str, typed: str, at: int | None) -> ExprError:
+    """An ExprError whose message shows where, in the text as typed: `theta + ◂here`."""
+    if at is None:
+        return ExprError(message, field="answer")
+    at = max(0, min(at, len(typed)))
+    before, after = typed[max(0, at - 24) : at], typed[at : at + 24]
+    shown = ("…" if at > 24 else "") + before + "⟨here⟩" + after
+    shown += "…" if at + 24 < len(typed) else ""
+    return ExprError(
+        f"{message} (at character {at + 1}: {shown.strip()})", field="answer", position=at
+    )

@@ -32,7 +32,8 @@ import numpy as np
 import sympy as sp
 from scipy.integrate import DOP853
 
-from mechanics.check import check, expected_quantity, read_answer
+from mechanics.answers import read_answer
+from mechanics.check import check, expected_quantity
 from mechanics.derive import Derivation
 from mechanics.expr import ExprError, to_latex
 from mechanics.model import T as t
