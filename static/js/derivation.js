@@ -2,6 +2,7 @@
 // MathJax) with buttons to copy a line as LaTeX or as plain text, and "your turn" boxes that check
 // an answer typed in plain notation (POST /api/v1/check).
 import { postJSON, typeset } from "./api.js";
+import { dottedTex, inline, inlineMath, nameTex } from "./texnames.js";
 
 const el = (tag, props = {}, ...children) => {
   const node = Object.assign(document.createElement(tag), props);
@@ -9,8 +10,6 @@ const el = (tag, props = {}, ...children) => {
   return node;
 };
 
-/** Inline `$x$` in the engine's sentences becomes MathJax's `\(x\)`. */
-const inlineMath = (text) => text.replace(/\$([^$]+)\$/g, "\\($1\\)");
 
 export function renderSteps(list, derivation, { target, coordinates }) {
   list.replaceChildren(...derivation.steps.map((step, k) => renderStep(step, k, target, coordinates)));
@@ -65,21 +64,24 @@ function copyButton(what, text) {
 }
 
 function yourTurn(stepId, target, coordinates) {
+  // prompts as math (MathJax typesets them with their step): Q_θ, θ̈₁, not Q_theta, theta1_ddot
   const asks = {
-    energy: [["T", null, "T ="], ["V", null, "V ="]],
-    forces: coordinates.map((q) => ["Q", q, `Q_${q} =`]),
-    lagrange: [["L", null, "L ="], ...coordinates.map((q) => ["eom", q, `equation of motion for ${q}:`])],
-    matrix: coordinates.length <= 3 ? coordinates.map((q) => ["accel", q, `${q}_ddot =`]) : [],
+    energy: [["T", null, `${inline("T")} =`], ["V", null, `${inline("V")} =`]],
+    forces: coordinates.map((q) => ["Q", q, `${inline(`Q_{${nameTex(q)}}`)} =`]),
+    lagrange: [["L", null, `${inline("L")} =`],
+      ...coordinates.map((q) => ["eom", q, `equation of motion for ${inline(nameTex(q))}:`])],
+    matrix: coordinates.length <= 3 ? coordinates.map((q) => ["accel", q, `${inline(dottedTex(q, 2))} =`]) : [],
   }[stepId] || [];
   return asks.map(([quantity, coordinate, prompt]) => {
     const box = el("details", { className: "yourturn" });
-    box.innerHTML = `<summary>Your turn: ${prompt.replace(/\s*[:=]$/, "")}</summary>
+    box.innerHTML = `<summary></summary>
       <div class="row"><span class="prompt"></span><input type="text" placeholder="e.g. 1/2 m l^2 theta'^2"
       aria-label="your answer"><button type="button" class="check">Check</button>
       <button type="button" class="reveal">Show answer</button></div>
       <div class="result" aria-live="polite" aria-atomic="true"><div class="echo"></div>
       <p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div></div>
       <div class="predict"></div>`;
+    box.querySelector("summary").textContent = `Your turn: ${prompt.replace(/\s*[:=]$/, "")}`;
     box.querySelector(".prompt").textContent = prompt;
     const input = box.querySelector("input");
     const result = box.querySelector(".result");

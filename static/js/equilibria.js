@@ -1,6 +1,7 @@
 // Equilibria of the scene at the current parameters (POST /api/v1/equilibria): where, whether
 // stable, the small-oscillation frequencies, and buttons that start the motion near one.
 import { postJSON, typeset } from "./api.js";
+import { inline, inlineMath, nameTex } from "./texnames.js";
 import { SceneGeometry } from "./geometry.js";
 import { fmt } from "./integrator.js";
 import { toSVG } from "./render.js";
@@ -17,21 +18,6 @@ const KIND_WORDS = {
   "marginal": "Marginal: the linear test cannot decide, the nonlinear terms do",
   "unstable": "Unstable: a small displacement grows",
 };
-
-const GREEK = new Set(["alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa",
-  "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi", "omega",
-  "Gamma", "Delta", "Theta", "Lambda", "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega"]);
-
-/** A coordinate's name as the derivation writes it: theta1 -> \theta_{1}, x -> x. */
-export function nameTex(name) {
-  const m = /^([A-Za-z]+?)_?(\d*)$/.exec(name);
-  if (!m) return `\\mathrm{${name.replace(/_/g, "\\_")}}`;
-  const base = GREEK.has(m[1]) ? `\\${m[1]}` : m[1];
-  return m[2] ? `${base}_{${m[2]}}` : base;
-}
-
-/** Inline math the page's MathJax renders: \(...\). */
-const inline = (tex) => `\\(${tex}\\)`;
 
 /** A small drawing of the system resting at q (one zero-length run gives the positions). */
 async function sketch(svg, target, parameters, spec, q) {
@@ -55,7 +41,7 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
     // every warning shown (a capped list, dry friction, a drive), its math ($…$) rendered
     const notes = (r.warnings.length || r.equilibria.length ? r.warnings : ["No equilibrium at these parameters."])
       .map((w) => Object.assign(document.createElement("p"), {
-        className: "muted eq-warning", textContent: w.replace(/\$([^$]+)\$/g, "\\($1\\)"),
+        className: "muted eq-warning", textContent: inlineMath(w),
       }));
     if (!r.equilibria.length) {
       box.replaceChildren(...notes);
