@@ -87,12 +87,15 @@ export function sceneShapes(geom, view, i, opts = {}) {
     const size = o.font - 1;
     for (const [, [x, y], amp] of elements) occupied.push([x - amp - 2, y - amp - 2, x + amp + 2, y + amp + 2]);
     for (const [name, mid, amp, n, side] of elements) {
-      if (!side) { placeLabel(out, occupied, mid, amp + 2, name, "#6c757d", w, h, size); continue; }
+      if (!side) { placeLabel(out, occupied, mid, amp + 2, name, "#6c757d", w, h, size, true); continue; }
       const reach = amp + 3 + size * (0.5 + 0.5 * Math.abs(n[0]));
       const c = [mid[0] + n[0] * side * reach, mid[1] + n[1] * side * reach];
       const tw = 0.6 * size * name.length;
+      const box = [c[0] - tw / 2, c[1] - size / 2, c[0] + tw / 2, c[1] + size / 2];
+      if (occupied.some((o) => box[0] < o[2] && box[2] > o[0] && box[1] < o[3] && box[3] > o[1])) continue;
+      if (box[0] < 0 || box[2] > w || box[1] < 0 || box[3] > h) continue;
       out.push({ t: "text", at: [c[0], c[1] + 0.35 * size], text: name, color: "#6c757d", size, halo: true, align: "center" });
-      occupied.push([c[0] - tw / 2, c[1] - size / 2, c[0] + tw / 2, c[1] + size / 2]);
+      occupied.push(box);
     }
   }
   if (o.scaleBar && !geom.is3D) scaleBar(view, out, o.font - 1);
@@ -361,8 +364,9 @@ function shade(hex) {
   return `rgb(${c.join(",")})`;
 }
 
-/** Put a body's name beside it where it overlaps nothing placed before (or the first try). */
-export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 12) {
+/** Put a body's name beside it where it overlaps nothing placed before (or the first try; an
+ * `optional` label, a spring's name, is left out instead). */
+export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 12, optional = false) {
   const tw = 0.6 * size * text.length, th = size;
   const g = r + 4;
   const tries = [[g, -g], [g, g + th * 0.6], [-g - tw, -g], [-g - tw, g + th * 0.6], [-tw / 2, -g - 4], [-tw / 2, g + th]];
@@ -374,6 +378,7 @@ export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 1
     pick = box;
     break;
   }
+  if (!pick && optional) return;
   if (!pick) {
     const left = Math.min(Math.max(0, x + g), w - tw), top = Math.min(Math.max(0, y - g - th), h - th - 2);
     pick = [left, top, left + tw, top + th + 2];
