@@ -263,3 +263,23 @@ def scene_live_module(scene_id: str) -> LiveModule:
     from mechanics.numeric import compiled_scene
 
     return live_module(compiled_scene(scene_id))
+
+
+def posted_live_json(key: str) -> dict:
+    """A posted spec's module and slot names (``key``: its canonical JSON, mechanics/jobs.py's
+    spec_key), for a pool worker: the spec is user input, derived under the pool's budget."""
+    import json
+
+    from mechanics.numeric import compiled_spec
+
+    live = live_module(compiled_spec(json.loads(key)))
+    return {
+        "source": live.source,
+        "digest": live.digest,
+        "coordinates": live.coordinates,
+        "parameters": live.parameters,
+        "points": live.points,
+        "frames": live.frames,
+        "solved": live.solved,
+        "extras": live.extras,
+    }

@@ -5,12 +5,14 @@ preview (mechanics/jscode.py)."""
 from __future__ import annotations
 
 import functools
+from collections import OrderedDict
 from typing import Any
 
 from fastapi import APIRouter, HTTPException, Request, Response
+from pydantic import BaseModel, ConfigDict
 from starlette.concurrency import run_in_threadpool
 
-from app.schemas import Message, SceneDetail, SceneSummary
+from app.schemas import Message, SceneDetail, SceneSpec, SceneSummary, ValidationErrors
 from mechanics.scenes import list_scenes, load_scene, scene_ids
 
 router = APIRouter(prefix="/api/v1/scenes", tags=["scenes"])
@@ -67,6 +69,66 @@ def _catalog() -> tuple[bytes, str]:
         entries.append(entry)
     body = orjson.dumps(entries, option=orjson.OPT_SERIALIZE_NUMPY)
     return body, hashlib.sha256(body).hexdigest()[:16]
+
+
+class LiveRequest(BaseModel):
+    """A spec of your own, for its equations as JavaScript (the editor's live preview)."""
+
+    model_config = ConfigDict(extra="forbid")
+    scene: SceneSpec
+
+
+#: Posted specs' modules by content hash, in this process (the least recently asked dropped past
+#: the limit). With several server processes a module's GET may reach another one and miss: a
+#: 404 the page answers by keeping server runs.
+_POSTED: OrderedDict[str, bytes] = OrderedDict()
+_POSTED_LIMIT = 256
+
+
+@router.post(
+    "/live",
+    responses={
+        422: {"model": ValidationErrors, "description": "The scene is invalid."},
+        503: {"model": Message, "description": "Past the time budget, or no JavaScript for it."},
+    },
+    summary="A posted scene's equations for the browser: the module's URL and slot names",
+)
+def post_live(request: LiveRequest, http: Request) -> Response:
+    """Like ``GET /{scene_id}/live`` for a spec of your own: derived (and printed) in the
+    worker pool under the derivation's time budget, the module kept here by its hash."""
+    import orjson
+
+    from app.derivations import in_pool, posted_key
+    from mechanics.jscode import JsUnavailable, posted_live_json
+
+    key = posted_key(request.scene)
+    try:
+        live = in_pool(
+            http, posted_live_json, key, affinity=key, what="printing this scene's equations"
+        )
+    except JsUnavailable as exc:
+        raise HTTPException(status_code=503, detail=f"no live preview: {exc}") from None
+    source = live.pop("source").encode()
+    digest = live.pop("digest")
+    _POSTED[digest] = source
+    _POSTED.move_to_end(digest)
+    while len(_POSTED) > _POSTED_LIMIT:
+        _POSTED.popitem(last=False)
+    body = {"module": f"/api/v1/scenes/live/{digest}.js", **live}
+    return Response(orjson.dumps(body), media_type="application/json")
+
+
+@router.get(
+    "/live/{digest}.js",
+    responses={404: {"model": Message}},
+    summary="A posted scene's equations as an ES module, by its content hash",
+)
+def get_posted_module(digest: str, request: Request) -> Response:
+    """The module ``POST /live`` printed, immutable under its hash."""
+    source = _POSTED.get(digest)
+    if source is None:
+        raise HTTPException(status_code=404, detail="no such module here: post the scene again")
+    return _cached(request, source, digest, "text/javascript", IMMUTABLE)
 
 
 @router.get(

@@ -43,11 +43,32 @@ export function postJSON(url, payload, { signal } = {}) {
   });
 }
 
-/** Render the LaTeX inside `elements` with MathJax (pages without it keep the source). */
+/** Render the LaTeX inside `elements` with MathJax (pages without it keep the source). MathJax
+ * may still be loading (a page can load it async, so it does not hold up the page's script). */
 export async function typeset(elements) {
-  const mj = window.MathJax;
-  if (!mj || !mj.startup) return;
+  let mj = await mathJax();
+  if (!mj) return;
+  await mj.startup.promise;
+  // Loaded before the page was parsed, MathJax defines typesetPromise only once its startup has
+  // run on the page: wait for it (a few frames) rather than fail.
+  for (let i = 0; i < 400 && typeof window.MathJax.typesetPromise !== "function"; i++) {
+    await new Promise((resolve) => setTimeout(resolve, 50));
+  }
+  mj = window.MathJax;
+  if (typeof mj.typesetPromise !== "function") return;
   await mj.startup.promise;
   mj.typesetClear?.(elements);
   await mj.typesetPromise(elements);
+}
+
+function mathJax() {
+  const ready = () => (window.MathJax && window.MathJax.startup ? window.MathJax : null);
+  if (ready() || !window.MathJax) return Promise.resolve(ready());
+  const script = [...document.scripts].find((s) => /mathjax\/.*\.js/.test(s.src));
+  if (!script) return Promise.resolve(null);
+  return new Promise((resolve) => {
+    script.addEventListener("load", () => resolve(ready()), { once: true });
+    script.addEventListener("error", () => resolve(null), { once: true });
+    setTimeout(() => resolve(ready()), 20000); // never wait forever for the math
+  });
 }

@@ -5,7 +5,7 @@
 // what it shows is a preview: the server's run (the measured one, with its method and tolerance)
 // replaces it when the slider is let go, and only the server's run feeds the integrator panel,
 // the plots and compare mode.
-import { getJSON } from "./api.js";
+import { getJSON, postJSON } from "./api.js";
 
 /** Substeps of RK4 per output sample at 60 fps: h = 1/600 s keeps a pendulum's preview within
  * ~1e-6 of the reference over 10 s, and costs a few ms. */
@@ -18,6 +18,13 @@ export class LiveModel {
   /** The scene's module and its slots' names; null when the server has none for it. */
   static async load(sceneId) {
     const meta = await getJSON(`/api/v1/scenes/${encodeURIComponent(sceneId)}/live`);
+    const mod = await import(meta.module);
+    return new LiveModel(meta, mod);
+  }
+
+  /** The same for a spec of one's own (the editor): printed by the server's worker pool. */
+  static async forSpec(spec) {
+    const meta = await postJSON("/api/v1/scenes/live", { scene: spec });
     const mod = await import(meta.module);
     return new LiveModel(meta, mod);
   }

@@ -80,6 +80,12 @@ class SceneView {
     $("reset").addEventListener("click", () => this.#reset());
     this.drag = new BodyDrag(this);
     this.#loop();
+    for (const id of ["plot-q", "plot-phase", "plot-energy"]) {
+      if ($(id) && !$(id).childElementCount) {
+        $(id).append(Object.assign(document.createElement("p"), {
+          className: "muted plot-wait", textContent: "Plotted when the server's run arrives…" }));
+      }
+    }
     if (specP) spec = (await specP).spec;
     await this.load(spec, query, derived);
   }
@@ -98,6 +104,13 @@ class SceneView {
     this.result = null;
     this.resultB = null;
     this.shown = null;
+    if (!this.sceneId) { // a spec of one's own: its equations printed for it, if they can be
+      this.live = null;
+      const asked = spec;
+      LiveModel.forSpec(spec)
+        .then((live) => { if (this.spec === asked) { this.live = live; this.preview(); } })
+        .catch((err) => { $("canvas").dataset.live = `unavailable: ${err.message}`; });
+    }
     this.preview();
     await Promise.all([this.derive(derivation), this.run(), this.equilibria()]);
   }
@@ -306,6 +319,7 @@ class SceneView {
       loadPlotly().then(() => this.#plot(), () => {});
       return;
     }
+    document.querySelectorAll(".plot-wait").forEach((el) => el.remove());
     const s = this.settings;
     plotRun({ a: this.result, b: this.resultB, labels: [s.method, s.methodB], spec: this.spec,
       phase: $("phase-q").value, lecture: this.lecture.on });
@@ -412,8 +426,15 @@ class SceneView {
     if (this.result) this.fbd(true);
     // One step at a time with a frame between: typesetting the whole derivation at once holds the
     // main thread for half a second, during which the animation could not start or move.
-    for (const item of [...steps.children]) {
+    // Until its turn, a step's LaTeX source is kept out of sight (its place kept, no jump).
+    const items = [...steps.children];
+    const raw = (item, hide) => item.querySelectorAll(".math, .text, .note").forEach((el) => {
+      el.style.visibility = hide ? "hidden" : "";
+    });
+    if (window.MathJax) items.forEach((item) => raw(item, true));
+    for (const item of items) {
       await typeset([item]);
+      raw(item, false);
       await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
     }
     steps.dataset.typeset = "1";

@@ -212,3 +212,30 @@ def test_a_drag_keeps_sixty_frames_a_second(server, page):
     )
     assert gaps[len(gaps) // 2] < 40  # 60 fps is 16.7 ms; a loaded CI machine gets slack
     assert page.errors == []
+
+
+def test_the_editors_own_spec_gets_a_live_preview_too(server, page):
+    """A spec of one's own: its equations are printed for it (POST /api/v1/scenes/live), so its
+    sliders move the motion live as well."""
+    p = page.page
+    p.goto(f"{server}/editor?from=double_pendulum")
+    p.wait_for_function("document.querySelector('#spec') && document.querySelector('#spec').value")
+    p.click("#derive")
+    p.wait_for_function("document.querySelector('#canvas').dataset.previews", timeout=90_000)
+    p.wait_for_function(
+        "document.querySelector('#canvas').dataset.source === 'server'", timeout=90_000
+    )
+    page.settle()
+    runs = _simulate_requests(p)
+    before = int(p.get_attribute("#canvas", "data-previews"))
+    p.evaluate(
+        """() => { const s = document.getElementById('s-theta2');
+                   s.value = String(Number(s.value) + 0.3);
+                   s.dispatchEvent(new Event('input', { bubbles: true })); }"""
+    )
+    p.wait_for_function(
+        "n => Number(document.querySelector('#canvas').dataset.previews) > n", arg=before
+    )
+    assert p.get_attribute("#canvas", "data-source") == "live"
+    assert runs == []
+    assert page.errors == []
