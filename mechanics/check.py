@@ -436,6 +436,8 @@ class _Judge:
         }.get(self.quantity, units.fmt(want))
         fb = []
         for term in sp.Add.make_args(sp.expand(given)):
+            if term == 0:  # "0" has every unit
+                continue
             have = units.dimension(term, dims)
             if have is None:
                 fb.append(

@@ -96,13 +96,16 @@ function animate(canvas, spec, params, r, legend) {
       drawCanvas(ctx, shapes.map((s) => recolor(s)));
     }
     const t = r.true.t[i];
-    ctx.fillStyle = "#495057";
-    ctx.font = "12px system-ui, sans-serif";
-    ctx.fillText(`t = ${t.toFixed(2)} s`, 8, 16);
-    if (r.parted_at != null && t >= r.parted_at) {
-      ctx.fillStyle = STUDENT_INK;
-      ctx.fillText("parted", 8, 32);
-    }
+    const label = (text, color, y) => { // a white halo keeps it readable over a body
+      ctx.font = "12px system-ui, sans-serif";
+      ctx.lineWidth = 3;
+      ctx.strokeStyle = "#fff";
+      ctx.strokeText(text, 8, y);
+      ctx.fillStyle = color;
+      ctx.fillText(text, 8, y);
+    };
+    label(`t = ${t.toFixed(2)} s`, "#495057", 16);
+    if (r.parted_at != null && t >= r.parted_at) label("parted", STUDENT_INK, 32);
     canvas.dataset.sample = String(i);
   };
   let frame = 0;
@@ -154,7 +157,11 @@ function energyPlot(r) {
     lo = Math.min(lo, Math.max(e, lo - 3 * scale));
     hi = Math.max(hi, Math.min(e, hi + 3 * scale));
   }
-  if (hi - lo < 1e-9 * scale) { lo -= 0.5 * scale; hi += 0.5 * scale; }
+  // integration noise (1e-9 of E) is not drawn as spikes: at least 5 % of the motion's energy
+  if (hi - lo < 0.05 * scale) {
+    const mid = (hi + lo) / 2;
+    [lo, hi] = [mid - 0.025 * scale, mid + 0.025 * scale];
+  }
   const pad = 0.08 * (hi - lo); // a flat true energy must not hide under the axis
   lo -= pad;
   hi += pad;
