@@ -25,6 +25,7 @@ import functools
 import itertools
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -84,29 +85,48 @@ class Verdict:
         return self.kind in STABLE_KINDS
 
 
+def _once(d: Derivation, what: str, key: Any, compute: Callable[[], Any]) -> Any:
+    """The symbolic work that does not depend on the parameter values, done once per derivation:
+    a slider move asks again with new numbers only, and sympy's share of an answer is then a
+    numeric evaluation of what was derived the first time."""
+    memo = d.__dict__.setdefault("_equilibria_memo", {})
+    if (what, key) not in memo:
+        memo[(what, key)] = compute()
+    return memo[(what, key)]
+
+
 def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dict[str, Any]:
     """Steps in the notes' order and every equilibrium at the given parameter values."""
     m = d.model
     values = {m.params[k]: sp.Float(v) for k, v in _checked(d, parameters or {}).items()}
-    conditions = _at_rest(Variant(m, d.work.mass_matrix, d.work.forcing, []))
+    conditions = _once(
+        d, "at rest", "", lambda: _at_rest(Variant(m, d.work.mass_matrix, d.work.forcing, []))
+    )
     steps = [_virtual_work_step(d, conditions)]
     warnings: list[str] = []
-    conditions = [_drop_idle_drive(c, m, values) for c in conditions]
+    conditions = [_drop_idle_drive(d, c, values) for c in conditions]
     if any(explicit_time(c, m) for c in conditions):
         warnings.append(
             "The forces at rest depend on time (a drive): there is no fixed "
             "equilibrium. Set the drive amplitude to 0 to find the undriven ones."
         )
         return {"steps": [s.to_json() for s in steps], "equilibria": [], "warnings": warnings}
-    periods = _periods(d)
+    periods = _once(d, "periods", "", lambda: _periods(d))
     found: list[tuple[Derivation, Root]] = []
-    variants = _variants(d, warnings)
+    variants, notes = _once(d, "variants", "", lambda: _variants(d))
+    warnings += notes
     for variant in variants:
-        conds = _at_rest(variant) if variant.label and len(variants) > 1 else conditions
+        if variant.label and len(variants) > 1:
+            conds = _once(d, "at rest", variant.label, functools.partial(_at_rest, variant))
+        else:
+            conds = conditions
         if len(variants) > 1:
             steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
-        conds = [_drop_idle_drive(c, m, values) for c in conds]
-        roots, notes = _equilibrium_points(variant, conds, values, periods)
+        conds = [_drop_idle_drive(d, c, values) for c in conds]
+        try:
+            roots, notes = _equilibrium_points(variant, conds, values, periods)
+        except _ConditionsOverflow as exc:
+            raise _beyond_doubles(d, parameters or {}, exc.q0, exc) from None
         for note in notes:
             if note not in warnings:
                 warnings.append(note)
@@ -139,7 +159,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
     steps.append(_stability_step(results, verdicts))
-    dry = _dry_friction(d)
+    dry = _once(d, "dry friction", "", lambda: _dry_friction(d))
     if dry:
         warnings.append(
             "Dry friction acts here (a force with the sign of a velocity): at rest it can take "
@@ -206,6 +226,15 @@ class _BeyondDoubles(ArithmeticError):
     """The linearization at an equilibrium is not finite in double precision."""
 
 
+class _ConditionsOverflow(_BeyondDoubles):
+    """The conditions themselves are not finite at a closed-form root (Ω = 1e308: Ω² R cos θ
+    overflows at θ = 0, and 0 · ∞ says nothing): no verdict on the root can be trusted."""
+
+    def __init__(self, q0: list[float]) -> None:
+        super().__init__()
+        self.q0 = q0
+
+
 def _beyond_doubles(d: Derivation, parameters: dict, q0: list[float], exc: Exception) -> SpecError:
     """A 422 naming the parameters whose size broke the linearization (m₂ = 1e265 beside
     m₁ = 1 makes M singular to double precision; Ω = 1e308 makes K infinite)."""
@@ -213,7 +242,9 @@ def _beyond_doubles(d: Derivation, parameters: dict, q0: list[float], exc: Excep
     values = {f"parameters.{k}": float(v) for k, v in _checked(d, parameters).items()}
     at = ", ".join(f"{q} = {v:.4g}" for q, v in zip(m.coordinate_names, q0, strict=True))
     what = "the linearization M δq̈ + C δq̇ + K δq = 0 overflows double precision"
-    if isinstance(exc, np.linalg.LinAlgError):
+    if isinstance(exc, _ConditionsOverflow):
+        what = "the conditions of equilibrium overflow double precision"
+    elif isinstance(exc, np.linalg.LinAlgError):
         what = "the mass matrix is singular to double precision"
     error = overflow_error(values, [f"parameters.{k}" for k in parameters], f"{what} at {at}")
     return SpecError([error])
@@ -245,11 +276,19 @@ def _at_rest(v: Variant) -> list[sp.Expr]:
     return [tidy(fj.xreplace(rest), m) for fj in v.forcing]
 
 
-def _drop_idle_drive(c: sp.Expr, m: Any, values: dict) -> sp.Expr:
+def _drop_idle_drive(d: Derivation, c: sp.Expr, values: dict) -> sp.Expr:
     """Terms with explicit t that vanish at these parameters (a drive set to 0) are dropped."""
-    terms = sp.Add.make_args(sp.expand(c))
-    idle = [a for a in terms if explicit_time(a, m) and a.xreplace(values) == 0]
-    return tidy(c - sp.Add(*idle), m) if idle else c
+    m = d.model
+    timed = _once(d, "timed terms", c, lambda: _timed_terms(c, m))
+    idle = tuple(a for a in timed if a.xreplace(values) == 0)
+    return _once(d, "without", (c, idle), lambda: tidy(c - sp.Add(*idle), m)) if idle else c
+
+
+def _timed_terms(c: sp.Expr, m: Any) -> tuple[sp.Expr, ...]:
+    """The terms of c with explicit t (a drive): expanding is sympy work, done once per c."""
+    if not explicit_time(c, m):
+        return ()
+    return tuple(a for a in sp.Add.make_args(sp.expand(c)) if explicit_time(a, m))
 
 
 def _checked(d: Derivation, parameters: dict[str, float]) -> dict[str, float]:
@@ -393,10 +432,11 @@ class Variant:
     label: str = ""
 
 
-def _variants(d: Derivation, warnings: list[str]) -> list[Variant]:
+def _variants(d: Derivation) -> tuple[list[Variant], list[str]]:
+    """Every side of every spring's anchor (bounded), with a note when not all were searched."""
     m, w = d.model, d.work
     springs = [s for s in m.springs if getattr(s, "branch", None) is not None]
-    variants = []
+    variants, warnings = [], []
     for flips in itertools.product((False, True), repeat=len(springs)):
         if len(variants) >= MAX_BRANCH_VARIANTS:
             warnings.append(
@@ -413,7 +453,7 @@ def _variants(d: Derivation, warnings: list[str]) -> list[Variant]:
             ranges.append(p)
             where.append(f"{s.name}: ℓ = {to_plain(p)}")
         variants.append(Variant(m, w.mass_matrix, forcing, ranges, ", ".join(where)))
-    return variants
+    return variants, warnings
 
 
 # --- the roots: closed form, checked and completed by a numeric search -----------------------
@@ -437,6 +477,10 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
         if not system.in_range(x)[0]:
             continue  # the other side of a spring's anchor, or a positive coordinate < 0
         if not system.residual_ok(x)[0]:
+            with np.errstate(all="ignore"):  # not finite here nor beside it: no pole, overflow
+                finite = np.all(np.isfinite(system.f(np.hstack([x, x + 1e-6]))), axis=0)
+                if not finite.any():
+                    raise _ConditionsOverflow([root.numeric.get(j, 0.0) for j in range(len(m.q))])
             notes.append(
                 "sympy gave "
                 + ", ".join(
@@ -478,13 +522,57 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
     return roots, notes
 
 
+@dataclass(frozen=True)
+class _ClosedForm:
+    """One solution of the conditions in closed form: per bound coordinate its expression, the
+    conditions under which it exists, and a numpy function of the parameters that evaluates it."""
+
+    exprs: tuple[sp.Expr, ...]
+    exists: str
+    exists_latex: str
+    evaluate: Callable[..., Any]
+
+
 def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
     """Closed-form roots with their existence conditions, or None when sympy cannot."""
-    if len(bound) > 2 or sum(sp.count_ops(e) for e in eqs) > SYMBOLIC_OPS_LIMIT:
+    psyms = tuple(sorted(values, key=str))
+    solved = _solved(tuple(eqs), tuple((j, m.q[j]) for j in bound), psyms)
+    if solved is None:
         return None
-    if len(bound) == 2 and any(e.has(*_TRIG) for e in eqs):
+    if not solved and not all(_never_zero(e, values) for e in eqs):
+        return None
+    point = list(np.array([complex(values[p]) for p in psyms], dtype=complex))
+    out = []
+    for sol in solved:
+        with np.errstate(all="ignore"):
+            try:
+                computed = [complex(x) for x in sol.evaluate(*point)]
+            except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+                continue
+        numeric, symbolic = {}, {}
+        for j, expr, value in zip(bound, sol.exprs, computed, strict=True):
+            if abs(value.imag) > 1e-12 or not math.isfinite(value.real):
+                break
+            wrapped, turns = _wrap(value.real, periods.get(j))
+            numeric[j] = wrapped
+            symbolic[j] = expr - 2 * sp.pi * turns if turns else expr
+        else:
+            out.append(Root(numeric, symbolic, sol.exists, exists_latex=sol.exists_latex))
+    return out
+
+
+@functools.lru_cache(maxsize=512)
+def _solved(eqs: tuple, bound: tuple, psyms: tuple) -> list[_ClosedForm] | None:
+    """sympy's closed-form solutions of the conditions, once per scene (they hold for every
+    parameter value; a slider move only evaluates them), or None when sympy cannot solve.
+    ``bound``: (index, q) of each coordinate solved for; the index names its symbol, which
+    orders the variables of sympy's polynomial algebra (and so how long it takes)."""
+    qs = tuple(q for _, q in bound)
+    if len(qs) > 2 or sum(sp.count_ops(e) for e in eqs) > SYMBOLIC_OPS_LIMIT:
+        return None
+    if len(qs) == 2 and any(e.has(*_TRIG) for e in eqs):
         return None  # sp.solve can run for minutes on two trig equations; the search covers it
-    subs = {m.q[j]: sp.Symbol(f"_q{j}", real=True) for j in bound}
+    subs = {q: sp.Symbol(f"_q{j}", real=True) for j, q in bound}
     back = {v: k for k, v in subs.items()}
     try:
         sols = sp.solve(
@@ -492,32 +580,32 @@ def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
         )
     except (NotImplementedError, ValueError, TypeError):
         return None
-    if not sols and not all(_never_zero(e, values) for e in eqs):
-        return None
     out = []
     for sol in sols:
-        if len(sol) < len(bound) or any(v.free_symbols & set(subs.values()) for v in sol.values()):
+        if len(sol) < len(qs) or any(v.free_symbols & set(subs.values()) for v in sol.values()):
             return None
-        numeric, symbolic, conditions_text, conditions_latex = {}, {}, [], []
-        for j in bound:
-            expr = sol[subs[m.q[j]]].xreplace(back)
-            conditions = _existence(expr)
-            conditions_text += [plain for plain, _ in conditions]
-            conditions_latex += [latex for _, latex in conditions]
-            try:
-                value = complex(expr.xreplace(values).evalf())
-            except (TypeError, ValueError):
-                value = complex(math.nan)
-            if abs(value.imag) > 1e-12 or not math.isfinite(value.real):
-                break
-            wrapped, turns = _wrap(value.real, periods.get(j))
-            numeric[j] = wrapped
-            symbolic[j] = expr - 2 * sp.pi * turns if turns else expr
-        else:
-            exists = " and ".join(conditions_text) or "always"
-            latex = r" \ \text{and}\  ".join(conditions_latex)
-            out.append(Root(numeric, symbolic, exists, exists_latex=latex))
+        exprs = tuple(sol[subs[q]].xreplace(back) for q in qs)
+        conditions = [c for expr in exprs for c in _existence(expr)]
+        exists = " and ".join(plain for plain, _ in conditions) or "always"
+        latex = r" \ \text{and}\  ".join(latex for _, latex in conditions)
+        out.append(_ClosedForm(exprs, exists, latex, _evaluator(list(exprs), psyms)))
     return out
+
+
+def _evaluator(exprs: list[sp.Expr], psyms: tuple) -> Callable[..., list]:
+    """numpy for speed; sympy's own evaluation where numpy has no name for a value (zoo)."""
+    try:
+        return sp.lambdify(psyms, exprs, modules="numpy", dummify=True)
+    except (KeyError, NameError, TypeError, SyntaxError):
+
+        def evaluate(*point: complex) -> list:
+            values = {
+                p: sp.Float(v.real) + sp.I * sp.Float(v.imag)
+                for p, v in zip(psyms, map(complex, point), strict=True)
+            }
+            return [e.xreplace(values).evalf() for e in exprs]
+
+        return evaluate
 
 
 def _never_zero(expr, values) -> bool:
@@ -540,7 +628,7 @@ def _existence(expr: sp.Expr) -> list[tuple[str, str]]:
 def _closed_form_guess(m, eqs, bound, point, periods) -> dict[int, sp.Expr] | None:
     """A numeric root at a simple value (kπ/12 for an angle, 0 or ± a parameter otherwise) that
     makes every condition vanish for any parameter values is a closed form that holds always."""
-    guesses = {}
+    guesses, defaults = {}, _param_values(m)
     for j in bound:
         x = point[j]
         candidates = [sp.S.Zero]
@@ -549,7 +637,7 @@ def _closed_form_guess(m, eqs, bound, point, periods) -> dict[int, sp.Expr] | No
         else:
             for p, v in m.spec.parameters.items():
                 candidates += [m.params[p], -m.params[p]] if abs(abs(x) - abs(v)) < 1e-6 else []
-        hit = [c for c in candidates if abs(float(c.xreplace(_param_values(m))) - x) < 1e-7]
+        hit = [c for c in candidates if abs(float(c.xreplace(defaults)) - x) < 1e-7]
         if not hit:
             return None
         guesses[j] = hit[0]
@@ -582,18 +670,18 @@ class _System:
         self.n = len(bound)
         self.bound = bound
         self.periods = [periods.get(j) for j in bound]
-        xs = [sp.Dummy(f"x{j}") for j in bound]
-        to_x = {m.q[j]: x for j, x in zip(bound, xs, strict=True)}
-        to_x.update({q: 0 for q in m.q if q not in to_x})
-        f = [e.xreplace(values).xreplace(to_x) for e in eqs]
-        self.f = _vectorized(f, xs)
-        self.jac = _vectorized([fi.diff(x) for fi in f for x in xs], xs)
-        self.scale = _vectorized(
-            [sp.Add(*(sp.Abs(a) for a in sp.Add.make_args(fi))) for fi in f], xs
-        )
         ranges = [m.q[j] for j in bound if m.coordinate_names[j] in m.spec.positive_coordinates]
         ranges += v.ranges
-        self.ranges = _vectorized([r.xreplace(values).xreplace(to_x) for r in ranges], xs)
+        psyms = tuple(sorted(values, key=str))
+        f, jac, scale, in_range = _conditions_numeric(
+            tuple(eqs), tuple(m.q[j] for j in bound), tuple(m.q), tuple(ranges), psyms
+        )
+        # numpy scalars: an overflow is inf (and judged), not Python's OverflowError
+        point = list(np.array([float(values[p]) for p in psyms], dtype=float))
+        self.f = functools.partial(f, point=point)
+        self.jac = functools.partial(jac, point=point)
+        self.scale = functools.partial(scale, point=point)
+        self.ranges = functools.partial(in_range, point=point)
         self.param_values = sorted({abs(float(v)) for v in values.values()} - {0.0})
         self.spread = max([1.0, *self.param_values])
         self.typical = 1.0
@@ -610,15 +698,33 @@ class _System:
         return np.all(R > 1e-9, axis=0) if len(R) else np.ones(X.shape[1], dtype=bool)
 
 
-def _vectorized(exprs: list[sp.Expr], xs: list[sp.Symbol]):
-    """numpy function of X (n × S) returning len(exprs) × S, nan where not real or finite."""
-    fn = sp.lambdify(xs, exprs, modules="numpy")
+@functools.lru_cache(maxsize=512)
+def _conditions_numeric(eqs: tuple, qs: tuple, all_qs: tuple, ranges: tuple, psyms: tuple):
+    """The conditions, their Jacobian, their terms' sizes and the coordinates' ranges as numpy
+    functions of the bound coordinates and the parameters, once per scene: a slider move only
+    calls them with new numbers."""
+    xs = [sp.Dummy(f"x{j}") for j in range(len(qs))]
+    to_x = dict(zip(qs, xs, strict=True))
+    to_x.update({q: 0 for q in all_qs if q not in to_x})
+    f = [e.xreplace(to_x) for e in eqs]
+    return (
+        _vectorized(f, xs, psyms),
+        _vectorized([fi.diff(x) for fi in f for x in xs], xs, psyms),
+        _vectorized([sp.Add(*(sp.Abs(a) for a in sp.Add.make_args(fi))) for fi in f], xs, psyms),
+        _vectorized([r.xreplace(to_x) for r in ranges], xs, psyms),
+    )
 
-    def call(X: np.ndarray) -> np.ndarray:
+
+def _vectorized(exprs: list[sp.Expr], xs: list[sp.Symbol], psyms: tuple = ()):
+    """numpy function of X (n × S) and the parameters' values (in psyms' order) returning
+    len(exprs) × S, nan where not real or finite."""
+    fn = sp.lambdify([*xs, *psyms], exprs, modules="numpy", dummify=True)
+
+    def call(X: np.ndarray, point: list[float] = ()) -> np.ndarray:
         if not exprs:
             return np.zeros((0, X.shape[1]))
         with np.errstate(all="ignore"):
-            out = fn(*X)
+            out = fn(*X, *point)
         rows = []
         for o in out:
             a = np.broadcast_to(np.asarray(o), X.shape[1:])
@@ -641,24 +747,31 @@ def _numeric_search(system: _System) -> list[list[float]]:
     system.typical = float(np.median(finite)) if finite.size else 1.0
     step_cap = np.array([1.0 if p else 0.5 * system.spread for p in system.periods])
     deadline = time.monotonic() + SEARCH_SECONDS
+    active = np.ones(X.shape[1], dtype=bool)  # starts still moving: the others are done
     for _ in range(MAX_NEWTON_STEPS):
         if time.monotonic() > deadline:
             system.timed_out = True
             break
-        F = system.f(X)
-        J = system.jac(X).reshape(n, n, -1).transpose(2, 0, 1)
+        Y = X[:, active]
+        F = system.f(Y)
+        J = system.jac(Y).reshape(n, n, -1).transpose(2, 0, 1)
         bad = ~(np.all(np.isfinite(F), axis=0) & np.all(np.isfinite(J), axis=(1, 2)))
         J[bad], F[:, bad] = 0.0, 0.0
         with np.errstate(all="ignore"):
             step = np.einsum("sij,sj->si", np.linalg.pinv(J, rcond=1e-13), F.T).T
         too_far = np.max(np.abs(step) / step_cap[:, None], axis=0)
         step /= np.maximum(too_far, 1.0)
-        X = X - step
-        X[:, bad] = np.nan
+        Y = Y - step
+        Y[:, bad] = np.nan
         for i, p in enumerate(system.periods):
             if p:
-                X[i] -= 2 * math.pi * np.floor((X[i] + math.pi) / (2 * math.pi))
-        if np.all(~np.isfinite(X[0]) | (np.max(np.abs(step), axis=0) < 1e-15)):
+                Y[i] -= 2 * math.pi * np.floor((Y[i] + math.pi) / (2 * math.pi))
+        X[:, active] = Y
+        # a start is done once it is lost or its step is below the last bits of its value
+        size = np.max(np.abs(step) - 4e-16 * np.abs(Y), axis=0)
+        moving = np.isfinite(Y[0]) & ~(size < 1e-15)
+        active[np.flatnonzero(active)[~moving]] = False
+        if not active.any():
             break
     alive = np.all(np.isfinite(X), axis=0)
     X = X[:, alive]
@@ -673,6 +786,15 @@ def _numeric_search(system: _System) -> list[list[float]]:
     return found
 
 
+def _grid_point(axes: list[list[float]], index: int) -> tuple[float, ...]:
+    """The index-th point of itertools.product(*axes): the last axis varies fastest."""
+    point = []
+    for axis in reversed(axes):
+        index, k = divmod(int(index), len(axis))
+        point.append(axis[k])
+    return tuple(reversed(point))
+
+
 def _starts(system: _System) -> np.ndarray:
     """A grid over each coordinate's range (angles: multiples of π/8 in (−π, π]; lengths: 0 and
     ± a ladder up to a few times the largest parameter), sampled down to MAX_STARTS."""
@@ -685,10 +807,14 @@ def _starts(system: _System) -> np.ndarray:
             ladder = [spread * 2.0**e for e in range(-4, 3)]
             ladder += [v * 1.1 for v in values if v > 0] + [v * 0.9 for v in values if v > 0]
             axes.append([0.013] + ladder + [-v for v in ladder])
-    grid = list(itertools.product(*axes))
-    if len(grid) > MAX_STARTS:
+    size = math.prod(len(axis) for axis in axes)
+    if size <= MAX_STARTS:
+        grid = list(itertools.product(*axes))
+    else:  # the grid's points by index (itertools.product's order), never the whole grid
         rng = np.random.default_rng(0)
-        grid = [grid[i] for i in sorted(rng.choice(len(grid), MAX_STARTS - 1, replace=False))]
+        grid = [
+            _grid_point(axes, i) for i in sorted(rng.choice(size, MAX_STARTS - 1, replace=False))
+        ]
         grid.insert(
             0,
             tuple(
@@ -700,6 +826,25 @@ def _starts(system: _System) -> np.ndarray:
 
 
 # --- stability from the full linearization ---------------------------------------------------
+
+
+_NOT_ELEMENTARY = (sp.sign, sp.Abs, sp.DiracDelta, sp.Heaviside, sp.Derivative, sp.Subs)
+
+
+@functools.lru_cache(maxsize=256)
+def _linearization(mass: tuple, forcing: tuple, qs: tuple, qds: tuple, qdds: tuple, psyms: tuple):
+    """M, K = −∂f/∂q and C = −∂f/∂q̇ at rest as one numpy function of (q, parameters), derived
+    once per scene; None where the forces are not smooth at rest, for sympy to judge."""
+    rest = {**dict.fromkeys(qdds, 0), **dict.fromkeys(qds, 0)}
+    K = [-_derivative(fj, q).xreplace(rest) for fj in forcing for q in qs]
+    C = [-_derivative(fj, qd).xreplace(rest) for fj in forcing for qd in qds]
+    M = [sp.S.Zero + e.xreplace(rest) for e in mass]
+    if any(e.has(*_NOT_ELEMENTARY) for e in (*M, *K, *C)):
+        return None
+    xs = [sp.Dummy(f"q{j}") for j in range(len(qs))]
+    to_x = dict(zip(qs, xs, strict=True))
+    exprs = [[e.xreplace(to_x) for e in group] for group in (M, K, C)]
+    return sp.lambdify([*xs, *psyms], exprs, modules="numpy", dummify=True)
 
 
 @functools.lru_cache(maxsize=4096)
@@ -718,20 +863,31 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
     Zero eigenvalues are neutral along free (cyclic) coordinates, undecided otherwise.
     """
     m = v.model
-    point = {**values, **{q: sp.Float(v) for q, v in zip(m.q, q0, strict=True)}}
-    rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
-
-    def num(e):
-        return float(sp.S.Zero + e.xreplace(rest).xreplace(point))
-
     n = len(m.q)
-    full_M = np.array([[num(v.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
+    psyms = tuple(sorted(values, key=str))
+    at_rest = _linearization(
+        tuple(v.mass_matrix), tuple(v.forcing), tuple(m.q), tuple(m.qd), tuple(m.qdd), psyms
+    )
+    if at_rest is not None:
+        numbers = list(np.array([float(values[p]) for p in psyms], dtype=float))
+        with np.errstate(all="ignore"):
+            M_, K_, C_ = (np.array(x, dtype=float) for x in at_rest(*q0, *numbers))
+        full_M = M_.reshape(n, n)
+    else:  # not smooth at rest (sign(q̇)): sympy says why (ValueError) where it cannot go on
+        point = {**values, **{q: sp.Float(v) for q, v in zip(m.q, q0, strict=True)}}
+        rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
+
+        def num(e):
+            return float(sp.S.Zero + e.xreplace(rest).xreplace(point))
+
+        full_M = np.array([[num(v.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
+        K_ = np.array([[-num(_derivative(fj, q)) for q in m.q] for fj in v.forcing])
+        C_ = np.array([[-num(_derivative(fj, qd)) for qd in m.qd] for fj in v.forcing])
     idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12]
     if not idx:
         return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
-    f = [v.forcing[j] for j in idx]
-    K = np.array([[-num(_derivative(fj, m.q[k])) for k in idx] for fj in f])
-    C = np.array([[-num(_derivative(fj, m.qd[k])) for k in idx] for fj in f])
+    K = K_.reshape(n, n)[np.ix_(idx, idx)]
+    C = C_.reshape(n, n)[np.ix_(idx, idx)]
     M = full_M[np.ix_(idx, idx)]
     if not all(np.all(np.isfinite(x)) for x in (M, C, K)):
         raise _BeyondDoubles
