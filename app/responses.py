@@ -15,16 +15,17 @@ from starlette.responses import Response
 _OPTIONS = orjson.OPT_SERIALIZE_NUMPY | orjson.OPT_NON_STR_KEYS
 
 
-def dumps(content: Any) -> bytes:
+def dumps(content: Any, sort: bool = False) -> bytes:
     """``content`` as compact JSON bytes; NaN and ±inf (an overflowing energy) become null.
 
     >>> dumps({"E": [1.5, float("nan"), float("inf")]})
     b'{"E":[1.5,null,null]}'
 
     JSON has no NaN/inf; orjson writes null for them, in Python floats and numpy arrays alike,
-    which is what app/routes/simulate.py's ``_finite`` did by walking the result.
+    which is what app/routes/simulate.py's ``_finite`` did by walking the result. ``sort``
+    orders the keys: a canonical form of a request, to key a cache by.
     """
-    return orjson.dumps(content, option=_OPTIONS)
+    return orjson.dumps(content, option=_OPTIONS | (orjson.OPT_SORT_KEYS if sort else 0))
 
 
 class ORJSONResponse(Response):
