@@ -11,7 +11,9 @@ records, from navigation start:
 - moving: the canvas has drawn two different frames of a run (a live preview or the server's);
 - server run: the server's run is on the canvas;
 - first visit: bytes transferred (compressed, headers included) until the page settled and its
-  plots were drawn; repeat: the same page opened again in the same context.
+  plots were drawn; repeat: the same page opened again in the same context;
+- 'Pause' over a blank canvas: animation frames in which the button said 'Pause' before anything
+  was drawn on the canvas or said there (the page's template says 'Pause' before its script runs).
 
 Needs Playwright and Debian's chromium (as the browser tests do). The numbers depend on the
 machine: on a shared 2-core box, run it alone.
@@ -164,9 +166,9 @@ def measure(url: str, scenes: list[str]) -> list[dict]:
 def table(rows: list[dict]) -> str:
     head = (
         "| scene | derivation (ms) | typeset (ms) | moving (ms) | server run (ms) | "
-        "first visit (kB, requests) | repeat (kB, requests) |"
+        "first visit (kB, requests) | repeat (kB, requests) | 'Pause' over a blank canvas |"
     )
-    lines = [head, "|" + "---|" * 7]
+    lines = [head, "|" + "---|" * 8]
 
     def ms(v):
         return "–" if v is None else f"{v:.0f}"
@@ -175,7 +177,7 @@ def table(rows: list[dict]) -> str:
         lines.append(
             f"| {r['scene']} | {ms(r['derivation'])} | {ms(r['typeset'])} | {ms(r['moving'])} | "
             f"{ms(r['server_run'])} | {r['first_kB']:.0f} ({r['first_requests']}) | "
-            f"{r['repeat_kB']:.1f} ({r['repeat_requests']}) |"
+            f"{r['repeat_kB']:.1f} ({r['repeat_requests']}) | {r['blank_while_pause']} frames |"
         )
     return "\n".join(lines)
 
