@@ -215,10 +215,15 @@ async function show(box, tex) {
   await typeset([box]);
 }
 
+/** The typeset equation each box was last fitted with (a box typeset again is fitted again). */
+const fitted = new WeakMap();
+
 /** Fit one `.math` box (its original LaTeX in data-latex) to its current width. */
 async function fitOne(box) {
   const width = box.clientWidth;
-  if (!width || box.dataset.fitWidth === String(width)) return;
+  const node = box.querySelector("mjx-container");
+  if (!width || !node) return; // not typeset yet: measured when it is
+  if (box.dataset.fitWidth === String(width) && fitted.get(box) === node) return;
   const original = box.dataset.latex;
   box.classList.remove("scrolls");
   box.removeAttribute("tabindex");
@@ -243,6 +248,7 @@ async function fitOne(box) {
   }
   scaleOrScroll(box);
   box.dataset.fitWidth = String(box.clientWidth);
+  fitted.set(box, box.querySelector("mjx-container"));
 }
 
 /** Shrink an equation a little to fit, else mark its box as scrolling (with the cue). */

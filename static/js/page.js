@@ -3,8 +3,6 @@
 // - Plot toolbars (plotly's .modebar buttons, a dozen per plot) are left out of the tab order, so
 //   Tab goes from the controls to the derivation, not through forty zoom buttons first; the
 //   toolbar still answers the mouse.
-// - An answer's verdict ("✔ Correct", "✘ Not yet") is a status message: screen readers announce it
-//   when it changes. The role is set as the box appears, before any answer is checked.
 // - On a phone, folded sections (details.fold[data-phone="closed"]) start closed, so the page is
 //   the animation and the derivation until a student opens the rest.
 // - A plot in a section just opened is redrawn at its width (plotly cannot measure a closed box).
@@ -14,7 +12,6 @@ const PHONE = "(max-width: 600px)";
 function tidy(root) {
   if (!(root instanceof Element)) return;
   for (const b of root.querySelectorAll(".modebar-btn:not([tabindex])")) b.setAttribute("tabindex", "-1");
-  for (const v of root.querySelectorAll(".verdict:not([role])")) v.setAttribute("role", "status");
 }
 
 function watch() {
