@@ -75,6 +75,7 @@ export class SceneGeometry {
     this.pulleys = new Map(); // point -> radius
     this.wheels = new Map(); // rigid body -> radius (world units), inferred from rolling
     this.wires = []; // {body, anchor, frame, q, local: [[x, y, z]...] in the frame, from the anchor}
+    this.surfaces = []; // {body, anchor, frame, lines: [local points...]}: a mesh of two sweeps
     this.ranges = this.#ranges();
     for (const b of this.bodies) this.#analyze(b);
     // a wire or hoop turning about an axis in the picture's plane needs depth to be seen
@@ -181,41 +182,74 @@ export class SceneGeometry {
    * do not reproduce the run's position at sample 0 (then nothing is drawn rather than a guess).
    */
   #sweep(body) {
-    const parts = positionParts(body.position);
-    if (!parts || !this.P[parts.anchor]) return null;
-    if (parts.frame && !(this.result.frames || {})[parts.frame]) return null;
-    const comps = parts.components.map(compile);
-    if (comps.some((c) => !c)) return null;
-    while (comps.length < 3) comps.push(compile(0));
-    const turns = this.frameNames(parts.frame);
-    if (!turns || [...turns].some((n) => this.coordinates.has(n))) return null; // a swinging frame: no fixed curve
-    const used = new Set(comps.flatMap((c) => [...c.names]));
-    const qs = [...used].filter((n) => this.coordinates.has(n));
-    if (qs.length !== 1 || used.has("t")) return null;
-    const q = qs[0];
-    const env = { ...this.parameters, t: this.result.t[0] };
-    for (const [name, v] of Object.entries(this.result.q || {})) env[name] = v[0];
-    const local = (value) => comps.map((c) => c({ ...env, [q]: value }));
-    // the spec, evaluated here, must put the body where the run did
-    const A = this.axesAt(parts.frame, 0), o = this.at(parts.anchor, 0), l0 = local(env[q]);
-    const here = add(o, add(mul(A[0], l0[0]), add(mul(A[1], l0[1]), mul(A[2], l0[2]))));
-    const there = this.at(body.name, 0);
-    if (!(norm(sub(here, there)) <= 1e-6 * (1 + norm(there)))) return null;
-    const closed = comps.every((c) => !c.names.has(q) || c.periodic.has(q));
-    let lo, hi;
-    if (closed) [lo, hi] = [env[q] - Math.PI, env[q] + Math.PI];
-    else {
-      [lo, hi] = this.ranges[q] || [env[q], env[q]];
-      const span = hi - lo > 1e-9 ? hi - lo : Math.max(1, Math.abs(env[q]));
-      [lo, hi] = [lo - 0.25 * span, hi + 0.25 * span];
-    }
+    const f = this.#positionFunction(body);
+    if (!f || f.qs.length !== 1) return null;
+    const q = f.qs[0], [lo, hi] = f.range(q);
     const pts = [];
     for (let k = 0; k < SWEEP; k++) {
-      const p = local(lo + ((hi - lo) * k) / (SWEEP - 1));
+      const p = f.local({ [q]: lo + ((hi - lo) * k) / (SWEEP - 1) });
       if (p.every(Number.isFinite)) pts.push(p);
     }
     if (pts.length < 2) return null;
-    return { body: body.name, anchor: parts.anchor, frame: parts.frame, q, local: pts, closed };
+    return { body: body.name, anchor: f.parts.anchor, frame: f.parts.frame, q, local: pts, closed: f.periodic(q) };
+  }
+
+  /** The spec's position of a body as local (frame, from anchor) points of its coordinates, when
+   * it reproduces the run at sample 0 and no frame turns with a coordinate; else null. */
+  #positionFunction(body) {
+    const parts = positionParts(body.position);
+    if (!parts || !this.P[parts.anchor]) return null;
+    if (parts.frame && !(this.result.frames || {})[parts.frame]) return null;
+    const turns = this.frameNames(parts.frame);
+    if (!turns || [...turns].some((n) => this.coordinates.has(n))) return null;
+    const comps = parts.components.map(compile);
+    if (comps.some((c) => !c)) return null;
+    while (comps.length < 3) comps.push(compile(0));
+    const used = new Set(comps.flatMap((c) => [...c.names]));
+    if (used.has("t")) return null;
+    const env = { ...this.parameters, t: this.result.t[0] };
+    for (const [name, v] of Object.entries(this.result.q || {})) env[name] = v[0];
+    const local = (values) => comps.map((c) => c({ ...env, ...values }));
+    const A = this.axesAt(parts.frame, 0), o = this.at(parts.anchor, 0), l0 = local({});
+    const here = add(o, add(mul(A[0], l0[0]), add(mul(A[1], l0[1]), mul(A[2], l0[2]))));
+    const there = this.at(body.name, 0);
+    if (!(norm(sub(here, there)) <= 1e-6 * (1 + norm(there)))) return null;
+    const qs = [...used].filter((n) => this.coordinates.has(n));
+    const periodic = (q) => comps.every((c) => !c.names.has(q) || c.periodic.has(q));
+    const range = (q) => {
+      if (periodic(q)) return [env[q] - Math.PI, env[q] + Math.PI];
+      const [lo, hi] = this.ranges[q] || [env[q], env[q]];
+      const span = hi - lo > 1e-9 ? hi - lo : Math.max(1, Math.abs(env[q]));
+      return [lo - 0.25 * span, hi + 0.25 * span];
+    };
+    return { parts, qs, local, periodic, range };
+  }
+
+  /**
+   * The surface a body is held to, when its position depends on two coordinates and not on t (a
+   * bead in a bowl): a mesh of the curves along which one coordinate changes and the other is
+   * held, over the ranges the run covered. Not drawn when it is the picture's own plane.
+   */
+  #surface(body) {
+    const f = this.#positionFunction(body);
+    if (!f || f.qs.length !== 2 || !this.is3D) return;
+    const [a, b] = f.qs, ra = f.range(a), rb = f.range(b);
+    const LINES = 9, POINTS = 41;
+    const at = (r, k, n) => r[0] + ((r[1] - r[0]) * k) / (n - 1);
+    const lines = [];
+    for (let j = 0; j < LINES; j++) {
+      const one = [], other = [];
+      for (let k = 0; k < POINTS; k++) {
+        one.push(f.local({ [a]: at(ra, k, POINTS), [b]: at(rb, j, LINES) }));
+        other.push(f.local({ [a]: at(ra, j, LINES), [b]: at(rb, k, POINTS) }));
+      }
+      for (const line of [one, other]) {
+        const ok = line.filter((p) => p.every(Number.isFinite));
+        if (ok.length > 1) lines.push(ok);
+      }
+    }
+    if (!lines.length) return;
+    this.surfaces.push({ body: body.name, anchor: f.parts.anchor, frame: f.parts.frame, lines });
   }
 
   /** One sample shows no motion: what holds the body is read from its swept curve instead. */
@@ -308,7 +342,9 @@ export class SceneGeometry {
         return;
       }
     }
-    if (!this.#track(body, idx) && wire) this.#fromSweep(body, wire);
+    if (this.#track(body, idx)) return;
+    if (wire) this.#fromSweep(body, wire);
+    else this.#surface(body);
   }
 
   /** A straight line in the world (a floor, an incline, a rope): true when it is one. */
@@ -437,6 +473,9 @@ export class SceneGeometry {
     for (const [b, r] of this.wheels) for (const i of idx) around(this.at(b, i), r);
     for (const h of this.hoops) around(this.at(h.anchor, 0), h.radius);
     const every = Math.max(1, Math.floor(idx.length / 40));
+    for (const sf of this.surfaces) {
+      for (const line of sf.lines) for (const p of this.wireAt({ ...sf, local: line.filter((_, j) => j % 8 === 0) }, idx[0])) pts.push(p);
+    }
     for (const w of this.wires) {
       for (let k = 0; k < idx.length; k += every) {
         const world = this.wireAt(w, idx[k]);

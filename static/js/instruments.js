@@ -137,7 +137,9 @@ export class Instruments {
     const works = shown.filter(([, , , w]) => w).map(([, l]) => l);
     this.caption.textContent = "All bars on one axis, over the whole run. V's zero is arbitrary (where " +
       "the datum is put), so only changes in V and E mean something." +
-      (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.` : " No work is done from outside: E stays constant.");
+      (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.`
+        : this.result.stats?.driven ? " A drive does work here; its bar comes with the server's run."
+          : " No work is done from outside: E stays constant.");
   }
 
   #updateBars(i) {

@@ -21,6 +21,12 @@ export function sceneShapes(geom, view, i, opts = {}) {
   if (geom.is3D && o.axes !== false) floorAndAxes(geom, view, out);
   grounds(geom, view, rad, out);
   for (const h of geom.hoops) hoop(geom, view, h, i, out);
+  for (const sf of geom.surfaces) {
+    for (const line of sf.lines) {
+      const pts = geom.wireAt({ ...sf, local: line }, i).map((p) => view.project(p).slice(0, 2));
+      out.push({ t: "poly", pts, color: "#ced4da", width: 1, alpha: 0.9, piece: "surface" });
+    }
+  }
   for (const w of geom.wires) wire(geom, view, w, i, out);
   for (const c of geom.cones) cone(geom, view, c, i, out);
   for (const [p, r] of geom.pulleys) {

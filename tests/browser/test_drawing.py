@@ -105,6 +105,24 @@ def test_a_bead_on_a_spinning_parabola_rides_its_wire_and_the_wire_turns(server,
     assert page.errors == []
 
 
+def test_a_bead_in_a_bowl_is_drawn_on_its_surface(server, page):
+    """Two coordinates and a curved surface: a mesh of it, not a wire and not a floor."""
+    bowl = {
+        "title": "Bead in a bowl",
+        "coordinates": ["u", "w"],
+        "parameters": {"m": 0.2, "k": 0.8, "g": G},
+        "initial": {"u": 0.6, "w": 0.0, "u_dot": 0.0, "w_dot": 1.2},
+        "bodies": [{"name": "bead", "mass": "m", "position": ["u", "k*(u**2 + w**2)", "w"]}],
+        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    }
+    p = page.page
+    post_in_editor(p, server, bowl)
+    p.wait_for_timeout(500)
+    assert p.get_attribute("#canvas", "data-pieces").split() == ["surface"]
+    assert p.get_attribute("#canvas", "data-view") == "3d"
+    assert page.errors == []
+
+
 def test_compare_mode_draws_both_runs_at_one_scale(server, page):
     p = page.page
     # Euler at a coarse step lets the oscillation grow: run B reaches farther than run A
