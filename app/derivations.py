@@ -30,6 +30,7 @@ import json
 import logging
 import os
 import threading
+import time
 from collections import Counter
 from collections.abc import AsyncIterator, Callable
 from contextlib import asynccontextmanager
@@ -54,6 +55,7 @@ DEFAULT_CHECK_SECONDS = 5.0
 POOL_WORKERS_ENV = "LAGRANGE_LAB_POOL_WORKERS"
 POOL_PER_CLIENT_ENV = "LAGRANGE_LAB_POOL_PER_CLIENT"
 TRUST_FORWARDED_ENV = "LAGRANGE_LAB_TRUST_FORWARDED"
+WARM_ENV = "LAGRANGE_LAB_WARM"
 
 SIMPLIFY_SCENE = (
     "simplify the scene (fewer coordinates or bodies, simpler expressions) and try again"
@@ -121,12 +123,54 @@ def stop_pool() -> None:
 @asynccontextmanager
 async def pool_lifespan(app: Any) -> AsyncIterator[None]:
     """The app's lifespan: the pool starts (its workers warm) before the first request and is
-    closed, its workers reaped, when the server stops."""
-    start_pool()
+    closed, its workers reaped, when the server stops. Unless ``LAGRANGE_LAB_WARM=0``, every
+    built-in scene is then made ready in the background (`warm_up`)."""
+    pool = start_pool()
+    stop = threading.Event()
+    if os.environ.get(WARM_ENV, "1").strip() != "0":
+        threading.Thread(target=warm_up, args=(pool, stop), name="warm-up", daemon=True).start()
     try:
         yield
     finally:
+        stop.set()
         stop_pool()
+
+
+#: The pool's client name for the warm-up: its jobs queue fairly behind real clients' ones.
+WARM_CLIENT = "warm-up"
+warm_state: dict[str, Any] = {"done": 0, "of": 0, "seconds": None}
+
+
+def warm_up(pool: WorkerPool, stop: threading.Event) -> None:
+    """Every built-in scene derived, compiled and its equilibria found, before students ask:
+    in this process (its simulations run here) and in the pool worker each scene's analysis
+    requests go to. One scene at a time, as one more client of the pool, so a request that
+    arrives meanwhile waits at most for one scene's work (and finds it done if it is the one
+    being warmed: the caches are single flight)."""
+    from mechanics.warm import warm_in_process, warm_in_worker
+
+    start = time.perf_counter()
+    ids = scene_ids()
+    warm_state.update(done=0, of=len(ids), seconds=None)
+    for scene_id in ids:
+        if stop.is_set():
+            return
+        try:
+            warm_in_process(scene_id)
+            pool.run(
+                warm_in_worker,
+                scene_id,
+                seconds=max(60.0, derive_seconds()),
+                client=WARM_CLIENT,
+                affinity=scene_id,
+                what=f"warming {scene_id}",
+                advice="it will be derived on first use",
+            )
+        except Exception as exc:  # noqa: BLE001 — a failed warm-up is a slower first request
+            log.warning("warming %s failed (%s): it will be derived on first use", scene_id, exc)
+        warm_state["done"] += 1
+    warm_state["seconds"] = round(time.perf_counter() - start, 2)
+    log.info("%d built-in scenes ready in %.1f s", len(ids), warm_state["seconds"])
 
 
 def client_of(http: Request) -> str:

@@ -51,6 +51,9 @@ class Settings:
     trust_forwarded: bool = False
     #: Largest request body in bytes; a larger one is refused with 413 as it streams in.
     max_body_bytes: int = 1024 * 1024
+    #: "0" switches off making every built-in scene ready when the server starts (derivation,
+    #: compiled equations, equilibria; in the background): the first request then pays for it.
+    warm: bool = True
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> Settings:
