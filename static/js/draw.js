@@ -100,7 +100,7 @@ export class Stage {
     if (peers.length > 1) this.view.center = all.center;
     this.follow = false;
     if (!g.is3D) {
-      const early = box(w, h).fit(peers.flatMap((s) => s.geom.extent(s.#firstSecond())), pad);
+      const early = box(w, h).fit(peers.flatMap((s) => s.geom.extent(s.#firstSecond(), false)), pad);
       // Travels far compared with its first second: follow it at one scale instead of
       // shrinking it to a dot; the scale keeps a few of the system's own sizes in view.
       if (early.scale > 6 * all.scale) {

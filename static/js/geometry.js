@@ -219,8 +219,9 @@ export class SceneGeometry {
     const range = (q) => {
       if (periodic(q)) return [env[q] - Math.PI, env[q] + Math.PI];
       const [lo, hi] = this.ranges[q] || [env[q], env[q]];
-      const span = hi - lo > 1e-9 ? hi - lo : Math.max(1, Math.abs(env[q]));
-      return [lo - 0.25 * span, hi + 0.25 * span];
+      if (hi - lo > 1e-9) return [lo - 0.25 * (hi - lo), hi + 0.25 * (hi - lo)];
+      const reach = Math.max(1, Math.abs(env[q])); // at rest: a unit either way, for a start
+      return [env[q] - reach, env[q] + reach];
     };
     return { parts, qs, local, periodic, range };
   }
@@ -457,8 +458,9 @@ export class SceneGeometry {
     return mul(pts.reduce(add, [0, 0, 0]), 1 / (pts.length || 1));
   }
 
-  /** World points the view must fit: every position along the run and the drawn extras. */
-  extent(frames = null) {
+  /** World points the view must fit: every position along the run and the drawn extras (the
+   * wires and surfaces, swept over the whole run's range, only with `sweeps`). */
+  extent(frames = null, sweeps = true) {
     const idx = frames || this.#samples();
     const pts = [];
     for (const name of Object.keys(this.P)) for (const i of idx) pts.push(this.at(name, i));
@@ -473,10 +475,10 @@ export class SceneGeometry {
     for (const [b, r] of this.wheels) for (const i of idx) around(this.at(b, i), r);
     for (const h of this.hoops) around(this.at(h.anchor, 0), h.radius);
     const every = Math.max(1, Math.floor(idx.length / 40));
-    for (const sf of this.surfaces) {
+    for (const sf of sweeps ? this.surfaces : []) {
       for (const line of sf.lines) for (const p of this.wireAt({ ...sf, local: line.filter((_, j) => j % 8 === 0) }, idx[0])) pts.push(p);
     }
-    for (const w of this.wires) {
+    for (const w of sweeps ? this.wires : []) {
       for (let k = 0; k < idx.length; k += every) {
         const world = this.wireAt(w, idx[k]);
         for (let j = 0; j < world.length; j += 6) pts.push(world[j]);

@@ -111,7 +111,7 @@ export class Instruments {
     let lo = 0, hi = 0;
     for (const [k] of shown) for (const v of e[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (hi - lo < 1e-12) hi = lo + 1;
-    const top = 14, bottom = 126, left = 44, width = 300 - left - 6;
+    const top = 14, bottom = 126, left = 52, width = 300 - left - 6;
     const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
     this.axis = { y, shown };
     const slot = width / Math.max(shown.length, 1);
