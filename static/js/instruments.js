@@ -16,9 +16,10 @@ const BARS = [ // key in the run's `energy`, label, colour; the work bars only w
   ["W_drive", "W_drive", "#9c36b5", true],
 ];
 export const GRAVITY = [["Earth", 9.81], ["Moon", 1.62], ["Mars", 3.71], ["Jupiter", 24.79], ["zero g", 0]];
-const BOX = "border:1px solid #dee2e6;border-radius:6px;padding:6px 8px;background:#fff;min-width:0";
-const HEAD = "font-size:12px;font-weight:600;color:#495057;margin:0 0 4px";
-const SMALL = "font-size:11px;color:#6c757d;margin:4px 0 0;line-height:1.3";
+// the page's colour variables (app.css), so lecture mode's dark theme applies here too
+const BOX = "border:1px solid var(--line,#dee2e6);border-radius:6px;padding:6px 8px;background:var(--panel,#fff);min-width:0";
+const HEAD = "font-size:12px;font-weight:600;color:var(--muted,#495057);margin:0 0 4px";
+const SMALL = "font-size:11px;color:var(--muted,#6c757d);margin:4px 0 0;line-height:1.3";
 const BUTTON = "font-size:12px;padding:2px 8px;margin:0 4px 0 0";
 
 const el = (tag, props = {}, style = "") => {
@@ -52,6 +53,7 @@ export class Instruments {
     const make = (text, by, title) => {
       const b = el("button", { type: "button", textContent: text, title, className: "step" }, "min-width:2.6em");
       b.dataset.step = String(by);
+      b.setAttribute("aria-label", title);
       b.addEventListener("click", () => this.step(by));
       return b;
     };
@@ -99,7 +101,7 @@ export class Instruments {
     this.svg.setAttribute("viewBox", "0 0 300 150");
     this.svg.setAttribute("role", "img");
     this.svg.setAttribute("aria-label", "energy bars");
-    this.svg.style.cssText = "width:100%;max-width:360px;height:auto;display:block";
+    this.svg.style.cssText = "width:100%;max-width:360px;height:auto;display:block;background:#fff;border-radius:4px";
     this.caption = el("p", {}, SMALL);
     box.append(this.svg, this.caption);
     this.box.append(box);
