@@ -13,6 +13,7 @@ cost (steps, evaluations, wall time), which is what it costs to compute.
 from __future__ import annotations
 
 import asyncio
+import gzip
 import threading
 from collections import OrderedDict
 from collections.abc import Awaitable, Callable
@@ -31,7 +32,23 @@ class AnswerMemo:
         self._bytes = 0
         self._lock = threading.Lock()
         self._flights: dict[str, asyncio.Future[bytes]] = {}
+        self._gzipped: dict[str, tuple[bytes, bytes]] = {}  # key: (answer, its gzip)
         self.hits = self.misses = 0
+
+    def gzipped(self, key: str, body: bytes) -> bytes:
+        """``body`` (the answer kept for ``key``) gzipped, once: an answer asked for again is
+        likely asked for many times, and compressing 200 kB costs more than finding it."""
+        with self._lock:
+            source, done = self._gzipped.get(key, (None, b""))
+        if source is body:  # the twin of this very answer, not of another kept under the key
+            return done
+        done = gzip.compress(body, 6, mtime=0)
+        with self._lock:
+            if self._answers.get(key) is body:  # only while this answer itself is kept
+                self._drop_gzipped(key)
+                self._gzipped[key] = (body, done)
+                self._bytes += len(done)
+        return done
 
     def get(self, key: str) -> bytes | None:
         with self._lock:
@@ -45,13 +62,21 @@ class AnswerMemo:
         if len(body) > self.max_bytes // 8:  # one huge answer must not flush everyone's
             return
         with self._lock:
-            old = self._answers.pop(key, None)
-            self._bytes -= len(old) if old is not None else 0
+            self._drop(key)
             self._answers[key] = body
             self._bytes += len(body)
             while len(self._answers) > self.max_entries or self._bytes > self.max_bytes:
-                _, dropped = self._answers.popitem(last=False)
-                self._bytes -= len(dropped)
+                self._drop(next(iter(self._answers)))
+
+    def _drop(self, key: str) -> None:
+        """Forget ``key``'s answer and its gzipped twin (the lock is held)."""
+        old = self._answers.pop(key, None)
+        self._bytes -= len(old) if old is not None else 0
+        self._drop_gzipped(key)
+
+    def _drop_gzipped(self, key: str) -> None:
+        _, old = self._gzipped.pop(key, (None, b""))
+        self._bytes -= len(old)
 
     async def get_or_compute(
         self, key: str, compute: Callable[[], Awaitable[tuple[bytes, bool]]]

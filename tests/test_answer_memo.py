@@ -95,3 +95,19 @@ def test_a_run_near_its_wall_time_is_not_shared():
     assert simulate_route._not_load_dependent(quick)
     assert not simulate_route._not_load_dependent(slow)
     assert not simulate_route._not_load_dependent(cut)
+
+
+def test_an_answer_asked_again_is_sent_gzipped_once_compressed():
+    import gzip
+
+    body = {"scene_id": "spring_mass_damper", "parameters": {"k": 7.5}, "t_end": 3, "fps": 30}
+    with TestClient(app) as client:
+        first = client.post("/api/v1/simulate", json=body)
+        again = client.post("/api/v1/simulate", json=body, headers={"accept-encoding": "gzip"})
+    assert again.headers["content-encoding"] == "gzip"
+    assert again.content == first.content  # httpx decodes it: the same answer
+    memo = simulate_route.built_in_runs
+    key = next(k for k in memo._answers if '"k":7.5' in k)
+    assert gzip.decompress(memo.gzipped(key, memo.get(key))) == first.content
+    # another answer under the same key is compressed as itself, never given the kept twin
+    assert gzip.decompress(memo.gzipped(key, b'{"other":1}')) == b'{"other":1}'
