@@ -21,6 +21,11 @@ The module exports::
     places(t, y, p, out)   // out[3k..3k+2] = x, y, z of point k (bodies and named points)
     axes(t, y, p, out)     // out[9f..9f+8] = the 3 axes of frame f in N (rows, as the server's)
     energy(t, y, p, out)   // out[0] = T, out[1] = V
+    stops(t, y, p, out)    // out[2k] = stop k's value (> 0 while the model holds), out[2k+1]
+                           // its guard (only_if; the stop applies where it is not < 0)
+
+A stop on a string's tension needs Newton's method and is not printed: the preview does not
+watch it (`LiveModule.stops` lists the ones it does, with their names and messages as data).
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ import functools
 import hashlib
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import sympy as sp
 from sympy.printing.codeprinter import PrintMethodNotImplementedError
@@ -159,6 +164,10 @@ class LiveModule:
     frames: list[str]
     solved: bool
     extras: int
+    #: The stops the module's ``stops`` evaluates, in its order: name, message, crossing.
+    stops: list[dict] = field(default_factory=list)
+    #: Stops the preview cannot watch (on a tension): their names.
+    unwatched: list[str] = field(default_factory=list)
 
 
 def live_module(c: CompiledScene) -> LiveModule:
@@ -224,12 +233,21 @@ def live_module(c: CompiledScene) -> LiveModule:
         temps, reduced = _cse(slotted([w.T, w.V]))
         energy = _function("energy", ["out[0]", "out[1]"], temps, reduced, printer)
         energy.append("}")
+
+        watched = [st for st in m.stops if st.when is not None]
+        unwatched = [st.name for st in m.stops if st.when is None]
+        conds = [e for st in watched for e in (st.when, 1 if st.only_if is None else st.only_if)]
+        temps, reduced = _cse(slotted(conds))
+        stops = _function(
+            "stops", [f"out[{i}]" for i in range(len(conds))], temps, reduced, printer
+        )
+        stops.append("}")
     except PrintMethodNotImplementedError as exc:
         raise JsUnavailable(f"cannot generate JavaScript: {str(exc).splitlines()[0]}") from exc
 
     dims = (
         f"export const dims = {{ n: {n}, extras: {len(rates)}, params: {len(c.parameters)}, "
-        f"points: {len(points)}, frames: {len(frames)} }};"
+        f"points: {len(points)}, frames: {len(frames)}, stops: {len(watched)} }};"
     )
     source = "\n".join(
         [
@@ -241,6 +259,7 @@ def live_module(c: CompiledScene) -> LiveModule:
             *places,
             *axes,
             *energy,
+            *stops,
             "",
         ]
     )
@@ -253,6 +272,8 @@ def live_module(c: CompiledScene) -> LiveModule:
         frames=frames,
         solved=c.solved,
         extras=len(rates),
+        stops=[{"name": st.name, "message": st.message, "crossing": st.crossing} for st in watched],
+        unwatched=unwatched,
     )
 
 
@@ -282,4 +303,6 @@ def posted_live_json(key: str) -> dict:
         "frames": live.frames,
         "solved": live.solved,
         "extras": live.extras,
+        "stops": live.stops,
+        "unwatched_stops": live.unwatched,
     }

@@ -15,9 +15,10 @@ import subprocess
 
 import numpy as np
 import pytest
+import sympy as sp
 
 from mechanics.jscode import JsUnavailable, checked_expression, live_module
-from mechanics.numeric import compiled_scene, compiled_spec, evaluate
+from mechanics.numeric import _args, _plain, compiled_scene, compiled_spec, evaluate
 from mechanics.scenes import scene_ids
 
 NODE = shutil.which("node")
@@ -35,9 +36,10 @@ process.stdin.on("end", () => {
   const out = cases.map(([t, y, p]) => {
     const dy = new Float64Array(y.length), pl = new Float64Array(3 * m.dims.points);
     const ax = new Float64Array(9 * m.dims.frames), e = new Float64Array(2);
+    const st = new Float64Array(2 * m.dims.stops);
     const code = m.rhs(t, Float64Array.from(y), Float64Array.from(p), dy);
-    m.places(t, y, p, pl); m.axes(t, y, p, ax); m.energy(t, y, p, e);
-    return { code, dy: [...dy], places: [...pl], axes: [...ax], energy: [...e] };
+    m.places(t, y, p, pl); m.axes(t, y, p, ax); m.energy(t, y, p, e); m.stops(t, y, p, st);
+    return { code, dy: [...dy], places: [...pl], axes: [...ax], energy: [...e], stops: [...st] };
   });
   process.stdout.write(JSON.stringify({ dims: m.dims, out }));
 });
@@ -86,6 +88,7 @@ def _agree(c, tmp_path, seed: int = 7) -> None:
         "params": len(p),
         "points": len(c.places),
         "frames": len(c.frames),
+        "stops": sum(st.when is not None for st in c.stop_specs),
     }
     assert live.points == list(c.places) and live.frames == list(c.frames)
     python = c.rhs(p)
@@ -99,6 +102,20 @@ def _agree(c, tmp_path, seed: int = 7) -> None:
         assert js["axes"] == pytest.approx(axes, rel=1e-12, abs=1e-12)
         energy = [v[0] for v in evaluate(c.energy, ts, q, qd, p)]
         assert js["energy"] == pytest.approx(energy, rel=1e-12, abs=1e-12)
+        assert js["stops"] == pytest.approx(_stop_values(c, t, y, p), rel=1e-12, abs=1e-12)
+
+
+def _stop_values(c, t: float, y: np.ndarray, p: list[float]) -> list[float]:
+    """Each printed stop's value and guard (1 without one), by sympy's own lambdify."""
+    args, subs = _args(c.derivation)
+    out = []
+    for st in c.stop_specs:
+        if st.when is None:
+            continue  # a tension stop: not printed (Newton's method)
+        for e in (st.when, st.only_if if st.only_if is not None else sp.Integer(1)):
+            fn = sp.lambdify(args, _plain(e, subs), modules="math")
+            out.append(float(fn(t, *y[: 2 * c.n], *p)))
+    return out
 
 
 @needs_node

@@ -167,6 +167,8 @@ async def get_live(scene_id: str, request: Request) -> Response:
         "frames": live.frames,
         "solved": live.solved,
         "extras": live.extras,
+        "stops": live.stops,
+        "unwatched_stops": live.unwatched,
     }
     import orjson
 

@@ -74,10 +74,13 @@ export class LiveModel {
     let y = this.state(initial);
     const k1 = new Float64Array(dim), k2 = new Float64Array(dim), k3 = new Float64Array(dim), k4 = new Float64Array(dim);
     const tmp = new Float64Array(dim);
-    const ys = [Float64Array.from(y)];
-    let t = 0, status = "ok", evaluations = 0;
+    const ys = [Float64Array.from(y)], ts = [0];
+    let t = 0, status = "ok", evaluations = 0, stop = null;
     const f = (time, state, out) => { evaluations++; return mod.rhs(time, state, p, out); };
-    outer: for (let s = 1; s < samples; s++) {
+    const watch = new StopWatch(this, p);
+    stop = watch.atStart(y);
+    if (stop) status = "stopped";
+    outer: for (let s = 1; s < samples && !stop; s++) {
       for (let j = 0; j < sub; j++) {
         let bad = f(t, y, k1);
         for (let i = 0; i < dim; i++) tmp[i] = y[i] + 0.5 * h * k1[i];
@@ -93,19 +96,27 @@ export class LiveModel {
           if (!Number.isFinite(next[i])) finite = false;
         }
         if (bad || !finite) { status = bad ? "singular" : "diverged"; break outer; }
+        const tNext = (s - 1) * dtOut + (j + 1) * h;
+        stop = watch.step(t, tNext, next);
         y = next;
-        t = s * dtOut - (sub - 1 - j) * h;
+        t = tNext;
+        if (stop) { // the preview ends where the model stops holding, as the server's run does
+          status = "stopped";
+          ys.push(Float64Array.from(y));
+          ts.push(stop.t);
+          break outer;
+        }
       }
       t = s * dtOut;
       ys.push(Float64Array.from(y));
+      ts.push(t);
     }
-    return this.#shape(ys, p, dtOut, { status, evaluations, steps: (ys.length - 1) * sub, h, started });
+    return this.#shape(ys, ts, p, { status, evaluations, steps: Math.max(0, ts.length - 1) * sub, h, started, stop });
   }
 
-  #shape(ys, p, dtOut, { status, evaluations, steps, h, started }) {
+  #shape(ys, t, p, { status, evaluations, steps, h, started, stop }) {
     const { n, mod, meta } = this;
     const count = ys.length;
-    const t = Array.from({ length: count }, (_, i) => i * dtOut);
     const q = {}, qd = {};
     meta.coordinates.forEach((name, i) => {
       q[name] = ys.map((y) => y[i]);
@@ -133,9 +144,9 @@ export class LiveModel {
       energy: { T, V, E, W_nc: Wnc, W_drive: new Array(count).fill(0) },
       stats: {
         method: PREVIEW_LABEL, preview: true, status, steps, rhs_evaluations: evaluations, step: h,
-        wall_time: (performance.now() - started) / 1000, samples: count,
+        wall_time: (performance.now() - started) / 1000, samples: count, ...(stop ? { stop } : {}),
       },
-      warnings: status === "ok" ? [] : [`The live preview stopped early (${status}).`],
+      warnings: status === "ok" || status === "stopped" ? [] : [`The live preview stopped early (${status}).`],
     };
   }
 
@@ -218,6 +229,59 @@ export class LiveModel {
     const qd = solveSmall(A, g);
     if (qd) free.forEach((j, i) => { x[this.n + j] = qd[i]; });
     return x;
+  }
+}
+
+/**
+ * The scene's stop conditions watched after every RK4 step (mechanics/stops.py's rule, without
+ * its event location: the preview ends at the step where a value crosses 0, its time placed by
+ * the secant). A stop applies where its guard is not < 0; a value turning undefined stops too.
+ */
+class StopWatch {
+  constructor(model, p) {
+    this.model = model;
+    this.p = p;
+    this.count = model.mod.dims.stops || 0;
+    this.before = new Float64Array(2 * this.count);
+    this.now = new Float64Array(2 * this.count);
+  }
+
+  #info(k, t) {
+    const s = this.model.meta.stops[k] || { name: `stop ${k}`, message: "a stop condition" };
+    return { name: s.name, message: s.message, t };
+  }
+
+  /** A 'falls' stop already at or past 0 ends the preview at t = 0 (the server refuses or
+   * stops such a start, and says which). */
+  atStart(y) {
+    if (!this.count) return null;
+    this.model.mod.stops(0, y, this.p, this.before);
+    for (let k = 0; k < this.count; k++) {
+      const v = this.before[2 * k], guard = this.before[2 * k + 1];
+      const falls = (this.model.meta.stops[k] || {}).crossing !== "any";
+      if (falls && !(v > 0) && !(guard < 0)) return this.#info(k, 0);
+    }
+    return null;
+  }
+
+  step(t0, t1, y) {
+    if (!this.count) return null;
+    this.model.mod.stops(t1, y, this.p, this.now);
+    let hit = null;
+    for (let k = 0; k < this.count && !hit; k++) {
+      const before = this.before[2 * k], now = this.now[2 * k], guard = this.now[2 * k + 1];
+      const applies = !(guard < 0);
+      const falls = (this.model.meta.stops[k] || {}).crossing !== "any";
+      const crossed = Number.isNaN(now) ? !Number.isNaN(before)
+        : falls ? before > 0 && now <= 0 && applies
+          : Math.sign(before) !== Math.sign(now) && before !== 0 && applies;
+      if (crossed) {
+        const at = Number.isFinite(before - now) && before !== now ? t1 - (now * (t1 - t0)) / (now - before) : t1;
+        hit = this.#info(k, Math.min(t1, Math.max(t0, at)));
+      }
+    }
+    this.before.set(this.now);
+    return hit;
   }
 }
 

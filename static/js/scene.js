@@ -270,7 +270,11 @@ class SceneView {
     this.time = Math.min(this.time, end);
     const c = $("canvas");
     c.dataset.source = source;
-    if (source === "live") c.dataset.previews = String(this.previews);
+    if (source === "live") {
+      c.dataset.previews = String(this.previews);
+      if (run.stats.stop) c.dataset.previewStop = String(run.stats.stop.t);
+      else delete c.dataset.previewStop;
+    }
     this.#label(run);
     this.stageA.draw(this.frameIndex());
     this.#syncPlay();
@@ -285,7 +289,8 @@ class SceneView {
       b.dataset.kind = "preview";
       b.textContent = `${PREVIEW_LABEL}, h = ${(st.step * 1000).toPrecision(2)} ms — a preview: `
         + (this.result ? "the server's run follows when you let go" : "the server's run is on its way");
-      if (st.status !== "ok") b.textContent += ` (stopped early: ${st.status})`;
+      if (st.stop) b.textContent += ` · stops at t = ${st.stop.t.toFixed(2)} s: ${st.stop.message}`;
+      else if (st.status !== "ok") b.textContent += ` (stopped early: ${st.status})`;
       Object.assign(b.style, { background: "#fff3bf", color: "#5c3c00", borderColor: "#f59f00" });
     } else {
       b.dataset.kind = "server";
