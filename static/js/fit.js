@@ -220,14 +220,14 @@ const fitted = new WeakMap();
 
 /** Fit one `.math` box (its original LaTeX in data-latex) to its current width. */
 async function fitOne(box) {
-  const width = box.clientWidth;
   const node = box.querySelector("mjx-container");
-  if (!width || !node) return; // not typeset yet: measured when it is
-  if (box.dataset.fitWidth === String(width) && fitted.get(box) === node) return;
+  if (!box.clientWidth || !node) return; // not typeset yet: measured when it is
+  if (box.dataset.fitWidth === String(box.clientWidth) && fitted.get(box) === node) return;
   const original = box.dataset.latex;
-  box.classList.remove("scrolls");
+  box.classList.remove("scrolls", "scaled");
   box.removeAttribute("tabindex");
   box.style.removeProperty("--fit-scale");
+  const width = box.clientWidth;
   if (original && box.dataset.broken) { // wider again: try the line as the engine wrote it
     await show(box, original);
     delete box.dataset.broken;
@@ -255,9 +255,11 @@ async function fitOne(box) {
 function scaleOrScroll(box) {
   const svg = box.querySelector("mjx-container > svg");
   if (!overflows(box)) return;
-  const scale = box.clientWidth / box.scrollWidth;
-  if (svg && scale >= MIN_SCALE) {
-    box.style.setProperty("--fit-scale", scale.toFixed(3));
+  // a few pixels of slack: a centred equation's edge lands on fractional pixels
+  const scale = (box.clientWidth - 4) / box.scrollWidth;
+  for (const s of [scale, scale * 0.97]) {
+    if (!svg || s < MIN_SCALE) break;
+    box.style.setProperty("--fit-scale", s.toFixed(3));
     box.classList.add("scaled");
     if (!overflows(box)) return;
   }

@@ -5,7 +5,8 @@ What "fits" means here, measured in the browser rather than taken from the style
 - the page is no wider than the window (``scrollingElement.scrollWidth <= innerWidth``), and no
   visible element's right edge lies beyond it, except inside a box that scrolls on purpose;
 - a display equation wider than its box is inside a box marked ``scrolls`` (the visible cue);
-- in lecture mode, every piece of text outside drawings (svg, canvas, plots, typeset math) is at
+- in lecture mode, no equation of the derivation scrolls at all (each is broken into lines or
+  scaled to fit), every piece of text outside drawings (svg, canvas, plots, typeset math) is at
   least 24 px, the size the issue asks for the back of a hall, and → / space / PageDown still
   reveal one more step each;
 - on a phone, every panel but the animation can be folded (a <details> with a summary).
@@ -134,6 +135,11 @@ def test_lecture_mode_fits_the_projector_on_every_scene(server, page, sized, sce
             sized(w, h)
             where = f"{scene} at {w}×{h}"
             assert_fits(p, where)
+            # on a projector no equation is left to scroll: each is broken or scaled to fit
+            scrolling = p.evaluate(
+                "[...document.querySelectorAll('#steps .math.scrolls')].map((m) => m.dataset.latex)"
+            )
+            assert scrolling == [], f"{where}: equations that still scroll: {scrolling}"
             small = p.evaluate(SMALL_TEXT, 24)
             assert not small, f"{where}: text under 24 px: {small}"
         page.settle()  # no run in flight when the next scene is opened
