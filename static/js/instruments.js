@@ -109,7 +109,10 @@ export class Instruments {
 
   #buildBars() {
     const e = this.result.energy || {};
-    const shown = BARS.filter(([k, , , work]) => e[k] && (!work || e[k].some((v) => Math.abs(v) > 1e-12)));
+    // a work bar only when the work is more than rounding noise against the energies themselves
+    let biggest = 1e-300;
+    for (const k of ["T", "V", "E"]) for (const v of e[k] || []) if (Math.abs(v) > biggest) biggest = Math.abs(v);
+    const shown = BARS.filter(([k, , , work]) => e[k] && (!work || e[k].some((v) => Math.abs(v) > 1e-9 * biggest)));
     let lo = 0, hi = 0;
     for (const [k] of shown) for (const v of e[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (hi - lo < 1e-12) hi = lo + 1;
@@ -122,7 +125,7 @@ export class Instruments {
       `<line x1="${x1}" y1="${y1.toFixed(1)}" x2="${x2}" y2="${y2.toFixed(1)}" stroke="${color}"${extra}/>`;
     parts.push(line(left, top, left, bottom, "#ced4da"));
     for (const v of [hi, 0, lo]) {
-      if (v !== 0 && Math.abs(v) < 1e-12) continue;
+      if (v !== 0 && Math.abs(y(v) - y(0)) < 12) continue; // would sit on the 0 label
       parts.push(`<text x="${left - 4}" y="${(y(v) + 3).toFixed(1)}" font-size="9" fill="#868e96" text-anchor="end">${fmtJ(v)}</text>`);
     }
     parts.push(line(left, y(0), 300 - 4, y(0), "#868e96"));

@@ -26,6 +26,7 @@ export function sceneShapes(geom, view, i, opts = {}) {
       const pts = geom.wireAt({ ...sf, local: line }, i).map((p) => view.project(p).slice(0, 2));
       out.push({ t: "poly", pts, color: "#ced4da", width: 1, alpha: 0.9, piece: "surface" });
     }
+    spinAround(geom, view, { ...sf, local: sf.lines.flat() }, i, out);
   }
   for (const w of geom.wires) wire(geom, view, w, i, out);
   for (const c of geom.cones) cone(geom, view, c, i, out);
@@ -221,9 +222,14 @@ function wire(geom, view, w, i, out) {
   const world = geom.wireAt(w, i);
   const pts = world.map((p) => view.project(p).slice(0, 2));
   out.push({ t: "poly", pts, color: "#868e96", width: 3, alpha: 0.9, cap: "round", closed: w.closed, piece: "wire" });
+  spinAround(geom, view, w, i, out);
+}
+
+/** The spin axis of the frame a wire or surface turns with, through its anchor, as long as the
+ * curve reaches along it (and a bit more). */
+function spinAround(geom, view, w, i, out) {
   const axis = spinAxis(geom, w.frame);
   if (axis === null) return;
-  // the spin axis through the anchor, as long as the wire reaches along it (and a bit more)
   const along = w.local.map((p) => p[axis]);
   const lo = Math.min(0, ...along), hi = Math.max(0, ...along);
   const size = Math.max(hi - lo, ...w.local.map((p) => Math.hypot(...p.filter((_, k) => k !== axis))), 1e-6);

@@ -69,7 +69,8 @@ def test_energy_bars_follow_the_motion_and_e_stays_put(server, page):
         assert b["E"] == pytest.approx(first["E"], abs=1e-6 * M * G * L)
     # one axis for every bar, up to the run's largest energy: T at the bottom, m g l (1 - cos θ0)
     hi = float(p.get_attribute("#instruments svg", "data-hi"))
-    assert hi == pytest.approx(M * G * L * (1 - math.cos(THETA0)), rel=2e-3)
+    # (the samples straddle the bottom: within 1/60 s of it at 30 samples/s, T is 0.3 % short)
+    assert hi == pytest.approx(M * G * L * (1 - math.cos(THETA0)), rel=5e-3)
     assert "arbitrary" in p.inner_text("#instruments")  # V's zero is said to be a choice
     assert page.errors == []
 
