@@ -1,0 +1,386 @@
+"""The work–precision trade for one scene, on demand: cost against error, and each method's order.
+
+Every method of the registry runs the same problem (the scene at the asked parameters and start,
+from 0 to ``t_end``) at several steps or tolerances; each run reports what it cost (wall time,
+RHS evaluations) and how wrong it was: the state at ``t_end`` against a tight reference
+(DOP853 at rtol = atol = 1e-13) and the energy error along the run (as /simulate measures it).
+
+From the points, each method's *measured* order is fitted by least squares on log–log axes:
+
+- fixed-step methods: log(error) against log(h). A method of order p has a global error C·h^p,
+  so the slope is p.
+- adaptive methods: log(error) against log(RHS evaluations), and the order is minus the slope.
+  The controller picks steps h whose *estimated* local error matches the tolerance, and that
+  estimate is of the embedded lower-order method (DOP853 advances with order 8 but estimates
+  with orders 5 and 3): error against tolerance has slope p/(q+1), not p. The evaluations count
+  the steps N ∝ 1/h, and the global error is still C·h^p ∝ N^(−p): against work the slope is −p.
+
+Only points in the asymptotic range enter a fit: a point whose error is at the reference's
+floor (rounding, or the reference's own error) or so large that the method is not yet
+converging (beyond stability, or no digit right) is shown but excluded, with the reason.
+
+The long run sets symplectic Euler beside RK4 at the same step over ~10³ periods: the first
+keeps its energy error bounded (it conserves a modified energy exactly), the second's drifts
+one way. Everything is bounded: each run gets what is left of one wall-time budget, and the
+long run has its own cap on steps and seconds; a run cut short says so and stays out of fits.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from mechanics.integrators import METHODS, Trajectory, integrate
+from mechanics.native import NativeUnavailable
+from mechanics.numeric import CompiledScene, compiled_scene, compiled_spec, evaluate
+from mechanics.simulate import MAX_BRANCH_FLIPS, SimulationRequest, _OtherBranch, check_request
+from mechanics.spec import SpecError
+
+MAX_METHODS = 6
+MAX_SETTINGS = 8
+MAX_T_END = 100.0
+#: Fixed steps one run may take, and all fixed-step runs of one request together.
+MAX_STEPS_PER_RUN = 200_000
+MAX_STEPS_TOTAL = 1_000_000
+#: Seconds for the comparison runs of one request (the reference included), and for the long run.
+MAX_SECONDS = 12.0
+LONG_RUN_SECONDS = 5.0
+LONG_RUN_PERIODS = 1000
+LONG_RUN_STEPS_PER_PERIOD = 30
+LONG_RUN_MAX_STEPS = 30_000
+#: The reference: DOP853 at the tightest tolerance the validation allows anyone.
+REF_TOL = 1e-13
+#: Samples along each run, for its energy error (and the reference's final state).
+SAMPLES = 201
+#: Errors below FLOOR × (1 + |state|) are at the reference's own accuracy; above CEILING × the
+#: same scale the method is not converging yet. Neither kind of point enters a fit.
+FLOOR = 1e-11
+CEILING = 1e-2
+
+DEFAULT_STEPS_PER_T_END = (100, 200, 400, 800, 1600, 3200)
+DEFAULT_TOLERANCES = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+
+
+@dataclass
+class PrecisionRequest:
+    """What to compare: fixed-step methods at ``steps`` (s), adaptive ones at ``tolerances``
+    (rtol = atol); None picks defaults (steps t_end/100 … t_end/3200, tolerances 1e-4 … 1e-10)."""
+
+    methods: list[str] = field(default_factory=lambda: ["euler", "rk4", "DOP853"])
+    parameters: dict[str, float] = field(default_factory=dict)
+    initial: dict[str, float] = field(default_factory=dict)
+    t_end: float = 10.0
+    steps: list[float] | None = None
+    tolerances: list[float] | None = None
+    long_run: bool = False
+
+
+def check_precision_request(req: PrecisionRequest) -> None:
+    """Bounds before any work, each error naming its field (the route's models check types)."""
+    errors = []
+
+    def bad(path: str, message: str) -> None:
+        errors.append({"field": path, "message": message})
+
+    if not req.methods:
+        bad("methods", "pick at least one method")
+    if len(req.methods) > MAX_METHODS:
+        bad("methods", f"at most {MAX_METHODS} methods at once")
+    if len(set(req.methods)) != len(req.methods):
+        bad("methods", "each method at most once")
+    for i, m in enumerate(req.methods):
+        if m not in METHODS:
+            bad(f"methods[{i}]", f"unknown method; one of {', '.join(METHODS)}")
+    if not (math.isfinite(req.t_end) and 0 < req.t_end <= MAX_T_END):
+        bad("t_end", f"must be > 0 and ≤ {MAX_T_END:g} s")
+    for name, values in (("steps", req.steps), ("tolerances", req.tolerances)):
+        if values is None:
+            continue
+        if not 1 <= len(values) <= MAX_SETTINGS:
+            bad(name, f"give 1 to {MAX_SETTINGS} values")
+        for i, v in enumerate(values):
+            if name == "steps" and not (math.isfinite(v) and v > 0):
+                bad(f"steps[{i}]", "must be a finite step > 0")
+            elif name == "steps" and math.isfinite(req.t_end) and req.t_end / v > MAX_STEPS_PER_RUN:
+                bad(f"steps[{i}]", f"t_end / step exceeds {MAX_STEPS_PER_RUN} steps")
+            elif name == "tolerances" and not (math.isfinite(v) and 1e-12 <= v <= 1e-2):
+                bad(f"tolerances[{i}]", "must be in [1e-12, 0.01] (above the reference's 1e-13)")
+    if errors:
+        raise SpecError(errors)
+    fixed = [m for m in req.methods if METHODS[m].kind == "fixed"]
+    steps = settings_of(req)[0]
+    total = len(fixed) * sum(math.ceil(req.t_end / h) for h in steps)
+    if total > MAX_STEPS_TOTAL:
+        bad("steps", f"the fixed-step runs together exceed {MAX_STEPS_TOTAL} steps")
+        raise SpecError(errors)
+
+
+def settings_of(req: PrecisionRequest) -> tuple[list[float], list[float]]:
+    """The steps and the tolerances the runs use (the defaults where none were given)."""
+    steps = req.steps or [req.t_end / k for k in DEFAULT_STEPS_PER_T_END]
+    return sorted(steps, reverse=True), sorted(req.tolerances or DEFAULT_TOLERANCES, reverse=True)
+
+
+def fitted_order(x: list[float], err: list[float]) -> float | None:
+    """Least-squares slope of log(err) against log(x); None with fewer than 2 distinct x."""
+    lx, ly = np.log(np.asarray(x, dtype=float)), np.log(np.asarray(err, dtype=float))
+    if len(lx) < 2 or np.ptp(lx) == 0:
+        return None
+    slope = np.polyfit(lx, ly, 1)[0]
+    return float(slope)
+
+
+class _Clock:
+    """One wall-time budget shared by a request's runs."""
+
+    def __init__(self, seconds: float) -> None:
+        self.deadline = time.perf_counter() + seconds
+
+    def left(self) -> float:
+        return max(0.0, self.deadline - time.perf_counter())
+
+
+def _run(c: CompiledScene, params, y0, t_eval, method: str, clock: _Clock, **kw: Any) -> Trajectory:
+    native = None
+    if method == "dop853_c":
+        try:
+            native = c.native_rhs(params)
+        except NativeUnavailable:
+            native = None  # the C loop calls the Python right-hand side back
+    return integrate(
+        c.rhs(params),
+        y0,
+        t_eval,
+        method=method,
+        second_order=c.n,
+        native=native,
+        max_wall_time=max(clock.left(), 1e-3),
+        max_steps=MAX_STEPS_PER_RUN + 1,
+        **kw,
+    )
+
+
+def energy_error(c: CompiledScene, params: list[float], run: Trajectory) -> np.ndarray:
+    """|E − E0| / max T along the run, as /simulate measures it: the energy where the scene
+    conserves it, the Jacobi integral where that is conserved instead, else the balance
+    E − E0 − W_NC − W_drive (every agent that does work on the right)."""
+    n, t, y = c.n, run.t, run.y
+    q, qd = y[:, :n].T, y[:, n : 2 * n].T
+    T, V = evaluate(c.energy, t, q, qd, params)
+    scale = max(float(np.max(np.abs(T))) if len(T) else 0.0, 1e-300)
+    conserved = {x["name"] for x in c.derivation.work.conserved}
+    if "energy" in conserved:
+        value = T + V
+    elif c.jacobi is not None:
+        (value,) = evaluate(c.jacobi, t, q, qd, params)
+    else:
+        value = T + V - y[:, 2 * n]
+        if c.drive is not None:
+            (e_minus_h,) = evaluate(c.drive, t, q, qd, params)
+            value = value - (e_minus_h - e_minus_h[0]) - (y[:, 2 * n + 1] if c.extras > 1 else 0)
+    return np.abs(value - value[0]) / scale
+
+
+def _grid(t_end: float, dt: float | None) -> tuple[np.ndarray, float | None]:
+    """Sample times of a run, and the step a fixed-step method then takes: it lands on every
+    sample with equal steps ≤ dt (mechanics/integrators.py), so a grid of at most SAMPLES
+    intervals, none shorter than dt, leaves the step the asked one or a little below it."""
+    if dt is None:
+        return np.linspace(0.0, t_end, SAMPLES), None
+    intervals = max(1, min(SAMPLES - 1, math.ceil(t_end / dt - 1e-9)))
+    per = math.ceil(t_end / intervals / dt - 1e-9)
+    return np.linspace(0.0, t_end, intervals + 1), t_end / (intervals * per)
+
+
+def _point(
+    c: CompiledScene, params, run: Trajectory, cost: Trajectory, reference: np.ndarray, scale
+) -> dict[str, Any]:
+    """One point of the diagram: ``cost`` is the run that went straight to t_end (an adaptive
+    method's sampled twin takes the same steps plus dense-output evaluations at the samples,
+    which are not the method's work), ``run`` the sampled one its errors are read from."""
+    ok = run.status == "ok" and cost.status == "ok"
+    err = float(np.max(np.abs(run.y[:, : 2 * c.n] - reference))) if ok else math.nan
+    energy = energy_error(c, params, run)
+    excluded = None
+    if not ok:
+        excluded = f"cut short: {run.message or cost.message}"
+    elif not math.isfinite(err):
+        excluded = "the state is not finite"
+    elif err <= FLOOR * scale:
+        excluded = "at the reference's floor (rounding, not the method)"
+    elif err >= CEILING * scale:
+        excluded = "not converging yet (no digit right, or beyond stability)"
+    return {
+        "wall_time": cost.wall_time,
+        "rhs_evaluations": cost.nfev,
+        "steps": cost.nsteps,
+        "error": err if math.isfinite(err) else None,
+        "energy_error": float(np.max(energy)) if np.all(np.isfinite(energy)) else None,
+        "status": "ok" if ok else "stopped",
+        "excluded": excluded,
+    }
+
+
+def work_precision(
+    c: CompiledScene,
+    params: list[float],
+    y0: np.ndarray,
+    req: PrecisionRequest,
+    seconds: float = MAX_SECONDS,
+) -> dict[str, Any]:
+    """The diagram's points and each method's fitted order (see the module's docstring).
+
+    A point's error is the largest |y − y_ref| over the samples and over q and q̇ (one final
+    state can pass near the reference by chance: a phase error crossing zero)."""
+    clock = _Clock(seconds)
+    references: dict[int, np.ndarray] = {}
+
+    def reference_on(t_eval: np.ndarray) -> np.ndarray:
+        if len(t_eval) not in references:
+            ref = _run(c, params, y0, t_eval, "dop853_c", clock, rtol=REF_TOL, atol=REF_TOL)
+            if ref.status != "ok":
+                message = f"the reference run did not finish: {ref.message}"
+                raise SpecError([{"field": "t_end", "message": message}])
+            references[len(t_eval)] = ref.y[:, : 2 * c.n]
+        return references[len(t_eval)]
+
+    start = time.perf_counter()
+    reference = reference_on(np.linspace(0.0, req.t_end, SAMPLES))
+    reference_seconds = time.perf_counter() - start
+    scale = 1.0 + float(np.max(np.abs(reference)))
+    steps, tolerances = settings_of(req)
+    methods = []
+    for name in req.methods:
+        info = METHODS[name]
+        fixed = info.kind == "fixed"
+        points = []
+        for setting in steps if fixed else tolerances:
+            kw = {"dt": setting} if fixed else {"rtol": setting, "atol": setting}
+            t_eval, h = _grid(req.t_end, setting if fixed else None)
+            run = _run(c, params, y0, t_eval, name, clock, **kw)
+            cost = run if fixed else _run(c, params, y0, t_eval[[0, -1]], name, clock, **kw)
+            point = _point(c, params, run, cost, reference_on(t_eval), scale)
+            points.append({"setting": setting, "h": h, **point})
+        used = [p for p in points if p["excluded"] is None]
+        x = [p["h"] if fixed else p["rhs_evaluations"] for p in used]
+        slope = fitted_order(x, [p["error"] for p in used])
+        methods.append(
+            {
+                "method": name,
+                "label": info.label,
+                "kind": info.kind,
+                "order": info.order,
+                "symplectic": info.symplectic,
+                "fitted_order": None if slope is None else (slope if fixed else -slope),
+                "fitted_against": "step h" if fixed else "RHS evaluations",
+                "points_in_fit": len(used),
+                "points": points,
+            }
+        )
+    return {
+        "t_end": req.t_end,
+        "reference": {"method": "DOP853", "rtol": REF_TOL, "wall_time": reference_seconds},
+        "error_scale": scale,
+        "methods": methods,
+        "seconds": seconds - clock.left(),
+        "cut": clock.left() == 0.0,
+    }
+
+
+def period_of(c: CompiledScene, params: list[float], y0: np.ndarray, t_end: float) -> float | None:
+    """The motion's period from its first coordinate's turning points (q̇₁ changes sign from + to
+    − once a period) over a reference run of up to 4·t_end; None if it never turns twice."""
+    t_eval = np.linspace(0.0, 4 * t_end, 4001)
+    run = _run(c, params, y0, t_eval, "dop853_c", _Clock(2.0), rtol=1e-10, atol=1e-10)
+    v = run.y[:, c.n]
+    i = np.nonzero((v[:-1] > 0) & (v[1:] <= 0))[0]
+    if len(i) < 2:
+        return None
+    t = run.t
+    crossings = t[i] + (t[i + 1] - t[i]) * v[i] / (v[i] - v[i + 1])
+    return float(np.mean(np.diff(crossings)))
+
+
+def long_run(c: CompiledScene, params: list[float], y0: np.ndarray, t_end: float) -> dict[str, Any]:
+    """Symplectic Euler against RK4 at one step h = period / 30 over 1000 periods (fewer
+    when the step budget or the time budget says so): each run's energy error envelope, the
+    largest |ΔE| in each of 100 windows, and whether it was cut."""
+    period = period_of(c, params, y0, t_end)
+    basis = "turning points of the first coordinate" if period else "t_end (no period found)"
+    period = period or t_end
+    h = period / LONG_RUN_STEPS_PER_PERIOD
+    periods = min(LONG_RUN_PERIODS, LONG_RUN_MAX_STEPS // LONG_RUN_STEPS_PER_PERIOD)
+    windows = 100
+    # two steps between samples: the steps land on the samples unchanged (h stays period / 30),
+    # and 15 samples a period find each period's largest T and |ΔE| (one a period would alias)
+    samples_per_window = periods * (LONG_RUN_STEPS_PER_PERIOD // 2) // windows
+    t_eval = np.linspace(0.0, periods * period, windows * samples_per_window + 1)
+    runs = {}
+    for method in ("symplectic_euler", "rk4"):
+        run = _run(c, params, y0, t_eval, method, _Clock(LONG_RUN_SECONDS / 2), dt=h)
+        err = energy_error(c, params, run)
+        reached = len(err) - 1
+        env = [
+            float(np.max(err[k * samples_per_window : (k + 1) * samples_per_window + 1]))
+            for k in range(reached // samples_per_window)
+        ]
+        runs[method] = {
+            "t": [float(t_eval[(k + 1) * samples_per_window]) for k in range(len(env))],
+            "energy_error": env,
+            "status": run.status,
+            "message": run.message,
+            "rhs_evaluations": run.nfev,
+            "wall_time": run.wall_time,
+        }
+    return {
+        "period": period,
+        "period_from": basis,
+        "periods": periods,
+        "h": h,
+        "runs": runs,
+    }
+
+
+def precision_compiled(c: CompiledScene, req: PrecisionRequest, seconds: float) -> dict[str, Any]:
+    check_precision_request(req)
+    sim = SimulationRequest(
+        parameters=req.parameters, initial=req.initial, t_end=req.t_end, fps=1.0, method="rk4"
+    )
+    sim.dt = req.t_end  # only to pass check_request's fixed-step check; nothing runs with it
+    params, y0 = check_request(c, sim)
+    out = work_precision(c, params, y0, req, seconds)
+    out["scene_parameters"] = dict(zip(c.parameters, params, strict=True))
+    out["long_run"] = long_run(c, params, y0, req.t_end) if req.long_run else None
+    return out
+
+
+def precision(
+    scene_id: str | None = None,
+    scene: dict | None = None,
+    request: PrecisionRequest | None = None,
+    seconds: float = MAX_SECONDS,
+) -> dict[str, Any]:
+    """The work–precision answer for a built-in scene (by id) or a spec; SpecError names bad
+    fields. A state across a spring's anchor runs on that side's derivation, as /simulate does."""
+    req = request or PrecisionRequest()
+    check_precision_request(req)
+    branches: dict[int, int] = {}
+    for _ in range(MAX_BRANCH_FLIPS):
+        key = tuple(sorted(branches.items()))
+        c = compiled_scene(scene_id, key) if scene_id is not None else compiled_spec(scene, key)
+        try:
+            return precision_compiled(c, req, seconds)
+        except _OtherBranch as other:
+            branches = {**c.derivation.model.branches, **other.flips}
+    raise SpecError([{"field": "initial", "message": "no derivation matches this state"}])
+
+
+def precision_job(key: str, req: PrecisionRequest, seconds: float) -> dict[str, Any]:
+    """A posted spec's work–precision in a pool worker (``key``: its canonical JSON)."""
+    import json
+
+    return precision(scene=json.loads(key), request=req, seconds=seconds)

@@ -1,0 +1,230 @@
+"""Work–precision runs (mechanics/precision.py, POST /api/v1/precision), checked against theory.
+
+The expected orders are the textbook ones (Euler 1, RK4 4, DOP853 8), and the long run is checked
+against closed forms for the linear oscillator worked out below, never against the code's output.
+The route is mounted on a small app of its own here (app/main.py wires it for the server).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from fastapi import FastAPI
+from fastapi.testclient import TestClient
+
+from app import derivations
+from app.errors import register_error_handlers
+from app.routes import precision as route
+from mechanics.precision import PrecisionRequest, precision
+from mechanics.scenes import load_scene, scene_ids
+
+api = FastAPI()
+api.include_router(route.router)
+register_error_handlers(api)
+client = TestClient(api)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _pool_closed_after():
+    yield
+    derivations.stop_pool()
+
+
+def fitted(result: dict, method: str) -> dict:
+    return next(m for m in result["methods"] if m["method"] == method)
+
+
+def test_euler_fitted_order_is_one_on_the_pendulum():
+    # 1 s from θ = 1 rad with h = 1e-3 … 6.25e-5: errors ~1e-3 … 1e-4, far above the floor and
+    # below the ceiling (Euler's error over one second is h·t·|y''|/2 ≈ h for this swing).
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["euler"],
+            initial={"theta": 1.0},
+            t_end=1.0,
+            steps=[1e-3 / 2**k for k in range(5)],
+        ),
+    )
+    euler = fitted(result, "euler")
+    assert euler["points_in_fit"] == 5
+    assert euler["fitted_order"] == pytest.approx(1.0, abs=0.3)
+
+
+def test_rk4_fitted_order_is_four_on_the_pendulum():
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["rk4"],
+            initial={"theta": 1.0},
+            t_end=10.0,
+            steps=[0.0125 / 2**k for k in range(4)],
+        ),
+    )
+    rk4 = fitted(result, "rk4")
+    assert rk4["points_in_fit"] == 4
+    assert rk4["fitted_order"] == pytest.approx(4.0, abs=0.3)
+    # the step taken is the one asked (it divides the sample interval 0.05 s exactly)
+    assert [p["h"] for p in rk4["points"]] == pytest.approx([0.0125 / 2**k for k in range(4)])
+    # 4 evaluations a step, t_end / h steps
+    assert [p["rhs_evaluations"] for p in rk4["points"]] == [4 * 800 * 2**k for k in range(4)]
+
+
+def test_dop853_fitted_order_against_work_is_eight_on_the_pendulum():
+    # Adaptive: error against RHS evaluations (minus the slope). Tolerances 1e-5 … 1e-10 keep the
+    # errors (~1e-4 … 1e-9) far above the reference's (1e-13). On this problem the slope depends
+    # on the amplitude and the range (8 to 10 over θ₀ ∈ [0.3, 2], t_end ∈ [5, 20]:
+    # docs/precision.md) — θ₀ = 1 rad over 10 s is in the range where it settles at 8.
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["DOP853"],
+            initial={"theta": 1.0},
+            t_end=10.0,
+            tolerances=[10.0**-k for k in range(5, 11)],
+        ),
+    )
+    dop = fitted(result, "DOP853")
+    assert dop["points_in_fit"] == 6
+    assert dop["fitted_order"] == pytest.approx(8.0, abs=0.3)
+    assert dop["fitted_against"] == "RHS evaluations"
+    # tighter tolerance: more work, smaller error
+    evals = [p["rhs_evaluations"] for p in dop["points"]]
+    assert evals == sorted(evals)
+
+
+def test_points_at_the_floor_or_not_converging_are_shown_but_left_out():
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["euler", "rk4"], initial={"theta": 1.0}, t_end=10.0, steps=[0.1, 1e-4]
+        ),
+    )
+    euler, rk4 = fitted(result, "euler"), fitted(result, "rk4")
+    # Euler with h = 0.1 over 10 s: E grows by (1 + h²ω²) a step: nothing right is left
+    assert "not converging" in euler["points"][0]["excluded"]
+    # RK4 at 1e-4: C·h⁴ ≈ 1e-4 · (1e-4/0.0125)⁴ ~ 1e-13: at the reference's floor
+    assert "floor" in rk4["points"][1]["excluded"]
+    assert rk4["fitted_order"] is None and rk4["points_in_fit"] == 1
+
+
+def test_long_run_symplectic_euler_bounded_rk4_drifts_as_theory_says():
+    """Linear oscillator (θ₀ = 0.1 rad), ν = ωh.
+
+    RK4 on y' = iωy multiplies y by R(iν) = 1 + iν − ν²/2 − iν³/6 + ν⁴/24 a step, and
+    |R|² = (1 − ν²/2 + ν⁴/24)² + (ν − ν³/6)² = 1 − ν⁶/72 + ν⁸/576: the energy (∝ |y|²) shrinks by
+    that factor every step, one way, so after N steps |ΔE|/E = 1 − |R|^(2N).
+
+    Symplectic Euler (v ← v − hω²q, q ← q + hv) conserves I = v² + ω²q² − hω²qv exactly
+    (substitute: I₁ = v₁v + ω²q² = I). Started at rest (qv = 0), E − E₀ = ½hω²·qv, and
+    ω|q||v| ≤ E, so |E − E₀| ≤ (ν/2)·E for ever: bounded, never drifting (and the bound is
+    reached: the error sits near it from the first periods on).
+    """
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["rk4"], initial={"theta": 0.1}, t_end=10.0, steps=[0.01], long_run=True
+        ),
+    )
+    lr = result["long_run"]
+    sym, rk4 = lr["runs"]["symplectic_euler"], lr["runs"]["rk4"]
+    assert sym["status"] == rk4["status"] == "ok"
+    omega = math.sqrt(9.81)  # small-oscillation ω = √(g/l), l = 1
+    assert lr["period"] == pytest.approx(2 * math.pi / omega, rel=2e-3)  # 0.1 rad: +0.06 %
+    nu = omega * lr["h"]
+    n_steps = round(lr["periods"] * lr["period"] / lr["h"])
+    assert n_steps == 30_000 and lr["periods"] == 1000
+
+    s = np.array(sym["energy_error"])
+    tenth = len(s) // 10
+    assert s[-tenth:].max() <= 2 * s[:tenth].max()
+    # |E − E₀| ≤ (ν/2)·E and E ≤ E₀/(1 − ν/2); max T ≥ E₀ (at q = 0, where qv = 0, E = E₀ = T):
+    # |E − E₀| / max T ≤ (ν/2)/(1 − ν/2), with 5 % for the pendulum's O(θ₀²) non-linearity
+    assert s.max() <= 1.05 * (nu / 2) / (1 - nu / 2)
+
+    r = np.array(rk4["energy_error"])
+    tenths = [r[k * tenth : (k + 1) * tenth].max() for k in range(10)]
+    assert all(b > a for a, b in zip(tenths, tenths[1:], strict=False))  # monotone drift
+    predicted = 1 - (1 - nu**6 / 72 + nu**8 / 576) ** n_steps
+    assert r[-1] == pytest.approx(predicted, rel=0.05)
+    assert r[-1] > 10 * r[0]
+
+
+def post(**body):
+    return client.post("/api/v1/precision", json=body)
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        ({"methods": ["euler", "rk4", "RK45", "DOP853", "Radau", "BDF", "LSODA"]}, "methods"),
+        ({"methods": ["leapfrog"]}, "methods[0]"),
+        ({"methods": ["rk4", "rk4"]}, "methods"),
+        ({"tolerances": [1e-3] * 9}, "tolerances"),
+        ({"tolerances": [1e-14]}, "tolerances[0]"),
+        ({"steps": [1e-6]}, "steps[0]"),
+        ({"steps": [-0.1]}, "steps[0]"),
+        ({"t_end": 0}, "t_end"),
+        ({"t_end": 1000}, "t_end"),
+        ({"parameters": {"lenght": 1}}, "parameters.lenght"),
+        ({"bogus": 1}, "bogus"),
+    ],
+)
+def test_bad_requests_are_422_naming_the_field(body, field):
+    r = post(scene_id="simple_pendulum", **body)
+    assert r.status_code == 422, r.text
+    assert any(d["field"] == field for d in r.json()["detail"]), r.json()
+
+
+def test_unknown_scene_is_404():
+    r = post(scene_id="no_such_scene")
+    assert r.status_code == 404
+    assert r.json()["detail"][0]["field"] == "scene_id"
+
+
+def test_built_in_answer_is_kept_and_served_again():
+    body = {
+        "scene_id": "simple_pendulum",
+        "methods": ["rk4"],
+        "steps": [0.02, 0.01],
+        "t_end": 2.0,
+    }
+    first = post(**body)
+    assert first.status_code == 200, first.text
+    hits = route.answers.hits
+    again = post(**body)
+    assert again.content == first.content
+    assert route.answers.hits == hits + 1
+
+
+def test_posted_spec_runs_in_the_pool_like_the_built_in_scene():
+    spec = load_scene("simple_pendulum")
+    body = {"methods": ["rk4"], "steps": [0.0125, 0.00625], "t_end": 10.0}
+    body["initial"] = {"theta": 1.0}
+    posted = post(scene=spec, **body)
+    built_in = post(scene_id="simple_pendulum", **body)
+    assert posted.status_code == 200, posted.text
+    a, b = fitted(posted.json(), "rk4"), fitted(built_in.json(), "rk4")
+    assert a["fitted_order"] == pytest.approx(4.0, abs=0.3)
+    # the same equations and steps: the same errors (the cost in seconds may differ)
+    assert [p["error"] for p in a["points"]] == pytest.approx([p["error"] for p in b["points"]])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scene_id", scene_ids())
+def test_every_built_in_scene_gives_a_diagram(scene_id):
+    r = post(
+        scene_id=scene_id,
+        methods=["symplectic_euler", "rk4", "DOP853"],
+        steps=[0.01, 0.005],
+        tolerances=[1e-6, 1e-8],
+        t_end=1.0,
+    )
+    assert r.status_code == 200, r.text
+    body = r.json()
+    assert [m["method"] for m in body["methods"]] == ["symplectic_euler", "rk4", "DOP853"]
+    for m in body["methods"]:
+        assert len(m["points"]) == 2
+        assert all(p["rhs_evaluations"] > 0 for p in m["points"])
