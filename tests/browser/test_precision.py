@@ -1,0 +1,120 @@
+"""The work–precision panel (static/js/precision.js) in a real page: mounted into a scene page,
+Run clicked, the fitted orders read from its table and checked against the textbook orders.
+
+The server here is the app with the precision router included if app/main.py does not include it
+yet (``precision_app``, a uvicorn factory), so the test does not depend on the wiring's timing.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def precision_app():
+    """app.main's app, with /api/v1/precision whether or not it is wired there yet."""
+    from app.main import app
+    from app.routes import precision
+
+    if not any(getattr(r, "path", "") == "/api/v1/precision" for r in app.routes):
+        app.include_router(precision.router)
+    return app
+
+
+@pytest.fixture(scope="module")
+def precision_server(tmp_path_factory):
+    from servers import free_port, serving
+
+    port = free_port()
+    env = {**os.environ, "LAGRANGE_LAB_CACHE": str(tmp_path_factory.mktemp("cache"))}
+    command = [
+        sys.executable,
+        "-m",
+        "uvicorn",
+        "test_precision:precision_app",
+        "--factory",
+        "--app-dir",
+        str(Path(__file__).parent),
+        "--port",
+        str(port),
+        "--log-level",
+        "warning",
+    ]
+    with serving(command, port, env=env, cwd=ROOT) as (url, _):
+        yield url
+
+
+@pytest.fixture(scope="module")
+def panel_page(browser, precision_server):
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
+    page = ctx.new_page()
+    errors: list[str] = []
+    page.on("console", lambda m: m.type == "error" and errors.append(m.text))
+    page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
+    page.goto(f"{precision_server}/scenes/simple_pendulum")
+    page.evaluate(
+        """async () => {
+          const m = await import('/static/js/precision.js');
+          const box = document.createElement('div');
+          box.id = 'precision-test';
+          document.querySelector('main').append(box);
+          window.__precision = m.mountPrecision(box, {
+            sceneId: 'simple_pendulum',
+            getState: () => ({ initial: { theta: 1.0, theta_dot: 0 } }),
+          });
+        }"""
+    )
+    page.wait_for_selector("#precision .methods[data-ready='1']")
+    yield page, errors
+    ctx.close()
+
+
+def test_run_shows_fitted_orders_near_the_textbook_orders(panel_page):
+    page, errors = panel_page
+    checked = page.eval_on_selector_all(
+        "#precision .methods input:checked", "boxes => boxes.map(b => b.value)"
+    )
+    assert checked == ["euler", "rk4", "DOP853"]
+    # RK4 in its asymptotic range on this swing, DOP853 over 1e-5 … 1e-10 (tests/test_precision.py)
+    page.fill("#precision-step-from", "0.0125")
+    page.fill("#precision-step-to", "0.0015625")
+    page.fill("#precision-tol-from", "1e-5")
+    page.fill("#precision-tol-to", "1e-10")
+    page.fill("#precision-count", "6")
+    page.fill("#precision-t-end", "10")
+    page.check("#precision-long-run")
+    page.click("#precision-run")
+    page.wait_for_selector("#precision[data-state='done']", timeout=90_000)
+    rows = page.eval_on_selector_all(
+        "#precision-orders tr[data-method]",
+        "rows => rows.map(r => [r.dataset.method, r.cells[1].textContent, "
+        "r.querySelector('.fitted').textContent])",
+    )
+    found = {m: (int(order), fitted) for m, order, fitted in rows}
+    assert set(found) == {"euler", "rk4", "DOP853"}
+    assert found["rk4"][0] == 4 and abs(float(found["rk4"][1]) - 4) <= 0.3
+    assert found["DOP853"][0] == 8 and abs(float(found["DOP853"][1]) - 8) <= 0.3
+    # the three log–log plots and the long run's are drawn
+    for plot in ("time", "evals", "energy", "long"):
+        assert page.locator(f"#precision-plot-{plot} .main-svg").count() >= 1, plot
+    long_text = page.inner_text("#precision-long")
+    assert "1000 periods" in long_text and "symplectic Euler" in long_text
+    assert "Done in" in page.inner_text("#precision-status")
+    assert not errors, errors
+
+
+def test_a_refused_request_is_shown_in_words(panel_page):
+    page, errors = panel_page
+    page.fill("#precision-step-from", "1e-7")  # t_end / step past 200000 steps
+    page.fill("#precision-step-to", "1e-8")
+    page.click("#precision-run")
+    page.wait_for_selector("#precision[data-state='error']", timeout=30_000)
+    assert "steps[0]" in page.inner_text("#precision-status")
+    errors.clear()  # the browser logs the 422 itself: that is the point of this test
