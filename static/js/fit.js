@@ -198,7 +198,9 @@ export function breakLine(tex, lines, fine = false) {
     const numParts = pieces(num, fine), denParts = pieces(den, fine);
     const share = Math.max(1, lines - 1);
     out.push(...alignedRows("\\text{num}", numParts, Math.ceil((share * num.length) / (num.length + den.length))));
-    out.push(...alignedRows("\\text{den}", denParts, Math.ceil((share * den.length) / (num.length + den.length))));
+    // rows in proportion to length: a short denominator stays on one line
+    const denRows = Math.max(1, Math.round((share * den.length) / (num.length + den.length)));
+    out.push(...alignedRows("\\text{den}", denParts, denRows));
   } else {
     const parts = pieces(rhs, fine);
     if (parts.length < 2) return null;
