@@ -101,16 +101,18 @@ def test_coriolis_term_comes_from_the_e_theta_component_through_d_dt():
     term = find(prov["eom"]["theta"]["lhs"], read("2*m*r*r_dot*theta_dot"), read)
     assert is_zero(read(term["plain"]) - coriolis.subs(t, dynamicsymbols._t))
     [source] = term["sources"]
-    assert source["kind"] == "kinetic" and source["body"] == "planet"
+    origin = prov["origins"][source["origin"]]
+    assert source["kind"] == origin["kind"] == "kinetic" and source["body"] == "planet"
     assert source["piece"] == "d/dt ∂T/∂q̇"
-    assert [c["unit"] for c in source["components"]] == ["e_theta"]
-    # ... and it came through T's term ½ m r² θ̇², itself from the ê_θ component.
+    assert origin["frame"] == "P" and origin["motion"] == "translational"
+    assert [c["unit"] for c in origin["components"]] == ["e_theta"]
+    # ... and it came through T's term ½ m r² θ̇², itself from the ê_θ component alone.
     t_term = find(prov["T"], read("m*r**2*theta_dot**2/2"), read)
     assert source["via"] == t_term["id"]
-    assert [c["unit"] for s in t_term["sources"] for c in s["components"]] == ["e_theta"]
+    assert [s["origin"] for s in t_term["sources"]] == [source["origin"]]
     # The centripetal term −m r θ̇² is the −∂T/∂r piece of the same component.
     [cent] = find(prov["eom"]["r"]["lhs"], read("-m*r*theta_dot**2"), read)["sources"]
-    assert cent["piece"] == "−∂T/∂q" and cent["components"][0]["unit"] == "e_theta"
+    assert cent["piece"] == "−∂T/∂q" and cent["origin"] == source["origin"]
 
 
 def test_double_pendulum_coupling_is_the_dot_product_of_both_links():
@@ -125,15 +127,20 @@ def test_double_pendulum_coupling_is_the_dot_product_of_both_links():
     coupling = m2 * l1 * l2 * sp.cos(th1 - th2) * th1.diff(tt) * th2.diff(tt)
     term = find(prov["T"], coupling, read)
     [source] = term["sources"]
-    assert source["body"] == "bob2" and source["motion"] == "translational"
-    assert [(c["link"], c["from"]) for c in source["components"]] == [
+    origin = prov["origins"][source["origin"]]
+    assert source["body"] == "bob2" and origin["motion"] == "translational"
+    assert [(c["link"], c["from"]) for c in origin["components"]] == [
         ("bob1", "O"),
         ("bob2", "bob1"),
     ]
     # Both bobs' weights feed θ₁'s gravity term g l₁ (m₁ + m₂) sin θ₁, one share each.
     g = read("g")
     gravity = find(prov["eom"]["theta1"]["lhs"], g * l1 * (read("m1") + m2) * sp.sin(th1), read)
-    assert sorted(s["name"] for s in gravity["sources"]) == ["bob1", "bob2"]
+    weights = [prov["origins"][s["origin"]] for s in gravity["sources"]]
+    assert sorted((w["source"], w["name"]) for w in weights) == [
+        ("weight", "bob1"),
+        ("weight", "bob2"),
+    ]
     assert {s["piece"] for s in gravity["sources"]} == {"∂V/∂q"}
 
 
@@ -145,8 +152,9 @@ def test_same_term_same_id_across_equations():
     ids_q = sorted(t["id"] for t in prov["Q"][name]["terms"])
     ids_rhs = sorted(t["id"] for t in prov["eom"][name]["rhs"]["terms"])
     assert ids_q == ids_rhs and len(ids_q) == 2
-    kinds = {s["name"]: s["kind"] for t in prov["Q"][name]["terms"] for s in t["sources"]}
-    assert set(kinds.values()) == {"generalized force"} and len(kinds) == 2
+    origins = [prov["origins"][s["origin"]] for t in prov["Q"][name]["terms"] for s in t["sources"]]
+    assert {o["kind"] for o in origins} == {"generalized force"}
+    assert sorted(o["source"] for o in origins) == ["damper", "force"]
 
 
 def test_too_many_terms_says_so(monkeypatch):
