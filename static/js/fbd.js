@@ -50,6 +50,7 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   const occupied = [];
   const used = new Set();
   const drawn = []; // [body, direction]: arrows alike in direction are drawn side by side
+  const labels = []; // {tip, d, text, sub, color}: placed once all arrows are drawn
   for (const b of geom.bodies) {
     const [x, y] = view.project(geom.at(b.name, i));
     occupied.push([x - 12, y - 12, x + 12, y + 12]);
@@ -73,15 +74,25 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
       const foot = [x - d[1] * side, y + d[0] * side];
       const tip = [foot[0] + d[0] * len, foot[1] + d[1] * len];
       shapes.push({ t: "arrow", a: foot, b: tip, color, width: 2.5, head: 10, dash: f.dashed ? [5, 3] : undefined });
+      // the arrow itself is taken: no label of another force may sit on it
+      for (let s = 4; s <= len; s += 6) {
+        const px = foot[0] + d[0] * s, py = foot[1] + d[1] * s;
+        occupied.push([px - 3, py - 3, px + 3, py + 3]);
+      }
       const { text, sub } = f.symbol ? { text: f.symbol[0], sub: f.symbol[1] } : labelParts(f.label);
       const key = `${text}_${sub}@${f.on}`;
       if (used.has(key)) continue;
       used.add(key);
-      const before = shapes.length;
-      placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, 13);
-      const label = shapes[before];
-      Object.assign(label, { text, sub, italic: true, weight: 600 });
+      labels.push({ tip, d, text, sub, color });
     }
+  }
+  // labels after every arrow is down, each just beyond its arrow's tip where that is free
+  for (const { tip, d, text, sub, color } of labels) {
+    const before = shapes.length;
+    const width = 0.62 * 13 * text.length + 0.6 * 13 * 0.75 * sub.length + 2;
+    placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, 13, { width, toward: d });
+    const label = shapes[before];
+    Object.assign(label, { text, sub, italic: true, weight: 600 });
   }
   for (const b of geom.bodies) {
     const [x, y] = view.project(geom.at(b.name, i));

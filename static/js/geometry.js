@@ -458,12 +458,26 @@ export class SceneGeometry {
     return mul(pts.reduce(add, [0, 0, 0]), 1 / (pts.length || 1));
   }
 
+  /** The named points something is drawn at: the bodies, what they hang from or turn about,
+   * spring ends, the spec's own points. The origin O alone, with nothing there, is not one (a
+   * disk far down its slope is not shrunk to keep O in view). */
+  #drawnPoints() {
+    const names = new Set([...this.bodies.map((b) => b.name), ...(this.spec.points || []).map((p) => p.name)]);
+    for (const [a] of this.links) names.add(a);
+    for (const s of [...(this.spec.springs || []), ...(this.spec.dampers || [])]) names.add(s.a).add(s.b);
+    for (const x of [...this.hoops, ...this.cones, ...this.wires, ...this.surfaces]) names.add(x.anchor);
+    return names;
+  }
+
   /** World points the view must fit: every position along the run and the drawn extras (the
    * wires and surfaces, swept over the whole run's range, only with `sweeps`). */
   extent(frames = null, sweeps = true) {
     const idx = frames || this.#samples();
     const pts = [];
-    for (const name of Object.keys(this.P)) for (const i of idx) pts.push(this.at(name, i));
+    const shown = this.#drawnPoints();
+    for (const name of Object.keys(this.P)) {
+      if (shown.has(name)) for (const i of idx) pts.push(this.at(name, i));
+    }
     const around = (c, r) => {
       for (let k = 0; k < 3; k++) {
         const e = [0, 0, 0];

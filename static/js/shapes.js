@@ -94,7 +94,7 @@ export function sceneShapes(geom, view, i, opts = {}) {
     const size = o.font - 1;
     for (const [, [x, y], amp] of elements) occupied.push([x - amp - 2, y - amp - 2, x + amp + 2, y + amp + 2]);
     for (const [name, mid, amp, n, side] of elements) {
-      if (!side) { placeLabel(out, occupied, mid, amp + 2, name, "#6c757d", w, h, size, true); continue; }
+      if (!side) { placeLabel(out, occupied, mid, amp + 2, name, "#6c757d", w, h, size, { optional: true }); continue; }
       const reach = amp + 3 + size * (0.5 + 0.5 * Math.abs(n[0]));
       const c = [mid[0] + n[0] * side * reach, mid[1] + n[1] * side * reach];
       const tw = 0.6 * size * name.length;
@@ -376,12 +376,21 @@ function shade(hex) {
   return `rgb(${c.join(",")})`;
 }
 
-/** Put a body's name beside it where it overlaps nothing placed before (or the first try; an
- * `optional` label, a spring's name, is left out instead). */
-export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 12, optional = false) {
-  const tw = 0.6 * size * text.length, th = size;
+/**
+ * Put a label beside a point where it overlaps nothing placed before (or the first try).
+ * opts: `optional` (a spring's name: left out when there is no free spot), `width` (px, when
+ * known better than from the character count), `toward` (a unit screen direction, an arrow's:
+ * first try the spot just beyond its tip).
+ */
+export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 12, opts = {}) {
+  const tw = opts.width ?? 0.6 * size * text.length, th = size;
   const g = r + 4;
   const tries = [[g, -g], [g, g + th * 0.6], [-g - tw, -g], [-g - tw, g + th * 0.6], [-tw / 2, -g - 4], [-tw / 2, g + th]];
+  if (opts.toward) {
+    const [dx, dy] = opts.toward;
+    tries.unshift([dx * (g + tw / 2) - tw / 2, dy * (g + th / 2) + th / 2]);
+  }
+  const optional = opts.optional;
   let pick = null;
   for (const [dx, dy] of tries) {
     const box = [x + dx, y + dy - th, x + dx + tw, y + dy + 2];
