@@ -15,7 +15,9 @@ What "fits" means here, measured in the browser rather than taken from the style
 from __future__ import annotations
 
 import json
+import re
 import urllib.request
+from pathlib import Path
 
 import pytest
 
@@ -204,3 +206,90 @@ def test_phone_every_scene_fits_and_folds(server, page, sized, scenes):
     )
     assert any("plots" in c for c in closed) and any("integrator" in c for c in closed), closed
     assert not script_errors(page)
+
+
+# ---------------------------------------------------------------- breaking equations (fit.js)
+FIT_JS = Path(__file__).resolve().parents[2] / "static" / "js" / "fit.js"
+
+
+def _normal(tex: str) -> str:
+    """LaTeX with the layout of a broken line taken out: what is left is the mathematics."""
+    for layout in (r"\begin{aligned}", r"\end{aligned}", "&", r"\\", r"\quad"):
+        tex = tex.replace(layout, "")
+    tex = tex.replace(r"\Bigl(", r"\left(").replace(r"\Bigr)", r"\right)")
+    return "".join(tex.split())
+
+
+def _rows(broken: str) -> list[str]:
+    inner = broken.removeprefix(r"\begin{aligned}").removesuffix(r"\end{aligned}")
+    return inner.split(r" \\ ")
+
+
+def _check_broken(tex: str, broken: str) -> None:
+    """A broken line says what the engine's line says: the same terms in the same order, a matrix
+    entry by entry, a fraction as num/den with num and den the original's."""
+    matrix = re.fullmatch(r"(.+?) = \\left\[\\begin\{matrix\}(.*)\\end\{matrix\}\\right\]", tex)
+    if matrix:
+        name, body = matrix.groups()
+        cells = [[c.strip() for c in row.split("&")] for row in body.split(r"\\")]
+        column = all(len(r) == 1 for r in cells)
+        text = _normal(broken)
+        for j, row in enumerate(cells, start=1):
+            for k in range(1, len(row) + 1):
+                sub = f"{j}" if column else f"{j}{k}"
+                assert _normal(f"{name}_{{{sub}}}=") in text
+        entries = re.split(r"\\mathbf\{\w\}_\{\d+\}=", text)[1:]
+        assert [_normal(c) for row in cells for c in row] == entries
+        return
+    if r"\text{num}" in broken:
+        text = _normal(broken)
+        lhs, rest = text.split(r"=\frac{\text{num}}{\text{den}}")
+        num, den = rest.removeprefix(r"\text{num}=").split(r"\text{den}=")
+        assert _normal(tex) == f"{lhs}=\\frac{{{num}}}{{{den}}}"
+        return
+    assert _normal(broken) == _normal(tex)
+    assert len(_rows(broken)) >= 2
+
+
+def test_broken_equations_say_what_the_engine_wrote(server):
+    """Every long line of three derivations, broken into 2, 3 and 5 lines, with and without
+    opening brackets, is the same mathematics (run by node on fit.js itself)."""
+    import shutil
+    import subprocess
+
+    if not shutil.which("node"):
+        pytest.skip("node is not installed")
+    lines = []
+    for scene in ("double_pendulum", "cart_pendulum", "incline_friction"):
+        request = urllib.request.Request(
+            f"{server}/api/v1/derive",
+            data=json.dumps({"scene_id": scene}).encode(),
+            headers={"content-type": "application/json"},
+        )
+        with urllib.request.urlopen(request, timeout=120) as r:
+            lines += [tex for step in json.load(r)["steps"] for tex in step["latex"]]
+    long = [tex for tex in lines if len(tex) > 120]
+    assert len(long) >= 10
+    script = (
+        "globalThis.window = {};\n"
+        f"const {{ breakLine }} = await import({json.dumps(str(FIT_JS))});\n"
+        "const lines = JSON.parse(process.argv[1]);\n"
+        "const out = lines.map((t) => [2, 3, 5].flatMap((n) => [false, true]"
+        ".map((fine) => breakLine(t, n, fine))));\n"
+        "console.log(JSON.stringify(out));\n"
+    )
+    done = subprocess.run(
+        ["node", "--input-type=module", "-e", script, json.dumps(long)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
+    broken_any = 0
+    for tex, variants in zip(long, json.loads(done.stdout), strict=True):
+        for broken in variants:
+            if broken is None:
+                continue
+            broken_any += 1
+            _check_broken(tex, broken)
+    assert broken_any >= 5 * len(long) // 2
