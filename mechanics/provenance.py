@@ -48,6 +48,11 @@ from mechanics.steps.energy import potential_parts
 MAX_TERMS = 200
 #: A derivation with more kinetic + potential origins than this is not traced.
 MAX_ORIGINS = 400
+#: The equations of motion are traced while (2 × shares of T + shares of V) × coordinates, the
+#: contributions to differentiate and split, stays within this: a triple pendulum has 114, a
+#: four-link chain 280 (2.5 s), a six-link chain about 1500 (8 s, on top of a 13 s derivation
+#: whose posted budget is 20 s).
+MAX_CONTRIBUTIONS = 600
 #: A contribution larger than this (count_ops) is shown expanded, not tidied: tidying every
 #: contribution was two thirds of the time on a six-link chain, and small ones are most of them.
 TIDY_OPS = 40
@@ -520,12 +525,19 @@ def provenance(derivation: Any) -> dict[str, Any]:
     eom: dict[str, Any] = {}
     t_parts = _through(T, kin, model)
     v_parts = _through(V, pot, model)
+    # Every share of T is differentiated twice per coordinate and V's once: past the budget the
+    # equations of motion are not traced (T, V and Q_j still are).
+    eom_too_large = (2 * len(t_parts) + len(v_parts)) * len(names) > MAX_CONTRIBUTIONS
     for j, name in enumerate(names):
         forces = force_origins(model, j)
         for i, o in enumerate(forces):
             o.id = f"Q{j + 1}.{i + 1}"
         table.update((o.id, o.to_json()) for o in forces)
         Q[name] = trace(work.Q[j], [Contribution(o, o.expr) for o in forces], model)
+        if eom_too_large:
+            skip = {"traced": False, "reason": TOO_LARGE, "terms": [], "cancelled": []}
+            eom[name] = {"lhs": skip, "rhs": Q[name]}
+            continue
         lhs: list[Contribution] = []
         q, qd = model.q[j], model.qd[j]
         for origin, via, e in t_parts:

@@ -164,3 +164,15 @@ def test_too_many_terms_says_so(monkeypatch):
     prov = provenance_json(derivation_of_scene("central_force"))
     assert prov["T"] == {"traced": False, "reason": TOO_LARGE, "terms": [], "cancelled": []}
     assert MAX_TERMS >= 100
+
+
+def test_equations_of_motion_past_the_budget_say_so(monkeypatch):
+    """Past MAX_CONTRIBUTIONS the EoMs are not traced (a six-link chain would double its derive
+    time); T, V and Q_j still are."""
+    import mechanics.provenance as pv
+
+    monkeypatch.setattr(pv, "MAX_CONTRIBUTIONS", 10)
+    prov = provenance_json(derivation_of_scene("double_pendulum"))
+    assert prov["T"]["traced"] and prov["V"]["traced"]
+    for eom in prov["eom"].values():
+        assert eom["lhs"] == {"traced": False, "reason": TOO_LARGE, "terms": [], "cancelled": []}
