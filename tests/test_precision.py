@@ -17,7 +17,8 @@ from fastapi.testclient import TestClient
 from app import derivations
 from app.errors import register_error_handlers
 from app.routes import precision as route
-from mechanics.precision import PrecisionRequest, precision
+from mechanics.numeric import compiled_scene
+from mechanics.precision import PrecisionRequest, long_run, precision
 from mechanics.scenes import load_scene, scene_ids
 
 api = FastAPI()
@@ -110,6 +111,21 @@ def test_points_at_the_floor_or_not_converging_are_shown_but_left_out():
     assert rk4["fitted_order"] is None and rk4["points_in_fit"] == 1
 
 
+def pendulum_at(theta: float):
+    """The built-in pendulum compiled, its parameters (m, l, g) and a start at rest at θ."""
+    return compiled_scene("simple_pendulum"), [1.0, 1.0, 9.81], np.array([theta, 0.0, 0.0])
+
+
+def test_long_run_is_cut_by_its_budget_and_says_so():
+    lr = long_run(*pendulum_at(0.1), t_end=10.0, seconds=0.2)
+    for run in lr["runs"].values():
+        assert run["status"] == "stopped"
+        assert "wall-time budget" in run["message"]
+        assert run["wall_time"] < 1.0
+    # what was reached is still reported, windows of 10 periods each
+    assert len(lr["runs"]["symplectic_euler"]["energy_error"]) < 100
+
+
 def test_long_run_symplectic_euler_bounded_rk4_drifts_as_theory_says():
     """Linear oscillator (θ₀ = 0.1 rad), ν = ωh.
 
@@ -122,13 +138,7 @@ def test_long_run_symplectic_euler_bounded_rk4_drifts_as_theory_says():
     ω|q||v| ≤ E, so |E − E₀| ≤ (ν/2)·E for ever: bounded, never drifting (and the bound is
     reached: the error sits near it from the first periods on).
     """
-    result = precision(
-        "simple_pendulum",
-        request=PrecisionRequest(
-            methods=["rk4"], initial={"theta": 0.1}, t_end=10.0, steps=[0.01], long_run=True
-        ),
-    )
-    lr = result["long_run"]
+    lr = long_run(*pendulum_at(0.1), t_end=10.0, seconds=120.0)  # the physics, not the budget
     sym, rk4 = lr["runs"]["symplectic_euler"], lr["runs"]["rk4"]
     assert sym["status"] == rk4["status"] == "ok"
     omega = math.sqrt(9.81)  # small-oscillation ω = √(g/l), l = 1

@@ -25,7 +25,7 @@ router = APIRouter(prefix="/api/v1", tags=["precision"])
 
 answers = AnswerMemo(max_entries=128, max_bytes=16 * 1024 * 1024)
 
-#: Seconds for one request's comparison runs (the long run has its own 5 s).
+#: Seconds for one request's comparison runs (the long run has its own 8 s).
 SECONDS = 12.0
 
 
@@ -71,7 +71,7 @@ class PrecisionIn(DeriveRequest):
     t_end: float = Field(default=10.0, description="Seconds of motion (≤ 100).")
     long_run: bool = Field(
         default=False,
-        description="Also symplectic Euler against RK4 at one step over 1000 periods (≤ 5 s).",
+        description="Also symplectic Euler against RK4 at one step over 1000 periods (≤ 8 s).",
     )
 
 

@@ -27,6 +27,8 @@ const STYLE = `
 .precision th, .precision td { border-bottom: 1px solid var(--line, #dee2e6); padding: .2rem .6rem; text-align: right; }
 .precision th:first-child, .precision td:first-child { text-align: left; }
 .precision .status { min-height: 1.2em; }
+.precision .table-scroll { overflow-x: auto; }
+.precision h3 { font-size: 1rem; margin: .8rem 0 .3rem; }
 .precision .error { color: #c92a2a; }
 `;
 
@@ -92,7 +94,7 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
         label("points", count), label("t_end (s)", tEnd),
         el("label", { className: "inline" }, longRun, " long run: symplectic Euler vs RK4, 1000 periods"),
         runButton)),
-    status, plots, table, longBox);
+    status, plots, el("div", { className: "table-scroll" }, table), longBox);
   container.append(root);
 
   getJSON("/api/v1/methods").then((methods) => {
