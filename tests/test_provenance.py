@@ -176,3 +176,19 @@ def test_equations_of_motion_past_the_budget_say_so(monkeypatch):
     assert prov["T"]["traced"] and prov["V"]["traced"]
     for eom in prov["eom"].values():
         assert eom["lhs"] == {"traced": False, "reason": TOO_LARGE, "terms": [], "cancelled": []}
+
+
+@pytest.mark.parametrize("scene_id", ["spring_mass_damper", "physical_pendulum", "central_force"])
+def test_the_json_has_the_documented_shape(scene_id):
+    """The documented model (app/provenance_schema.py) reads the JSON without losing a key."""
+    from app.provenance_schema import Provenance
+
+    prov = provenance_json(derivation_of_scene(scene_id))
+    parsed = Provenance.model_validate(prov).model_dump(exclude_none=True)
+    assert set(parsed) == set(prov)
+    for n, eom in prov["eom"].items():
+        for side in ("lhs", "rhs"):
+            for term, dumped in zip(
+                eom[side]["terms"], parsed["eom"][n][side]["terms"], strict=True
+            ):
+                assert dumped["sources"] == term["sources"]
