@@ -238,3 +238,14 @@ def test_every_built_in_scene_gives_a_diagram(scene_id):
     for m in body["methods"]:
         assert len(m["points"]) == 2
         assert all(p["rhs_evaluations"] > 0 for p in m["points"])
+
+
+def test_openapi_documents_the_route_with_the_registry_as_enum():
+    document = client.get("/openapi.json").json()
+    post_op = document["paths"]["/api/v1/precision"]["post"]
+    assert {"404", "422", "503"} <= set(post_op["responses"])
+    schema = document["components"]["schemas"]["PrecisionIn"]["properties"]["methods"]
+    from mechanics.integrators import METHODS
+
+    assert schema["items"]["enum"] == list(METHODS)
+    assert schema["maxItems"] == 6

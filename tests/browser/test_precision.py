@@ -118,3 +118,31 @@ def test_a_refused_request_is_shown_in_words(panel_page):
     page.wait_for_selector("#precision[data-state='error']", timeout=30_000)
     assert "steps[0]" in page.inner_text("#precision-status")
     errors.clear()  # the browser logs the 422 itself: that is the point of this test
+
+
+def test_a_posted_spec_runs_from_the_panel(browser, precision_server):
+    ctx = browser.new_context(viewport={"width": 1024, "height": 768}, bypass_csp=True)
+    page = ctx.new_page()
+    try:
+        page.goto(f"{precision_server}/editor")
+        page.evaluate(
+            """async () => {
+              const m = await import('/static/js/precision.js');
+              const spec = (await (await fetch('/api/v1/scenes/simple_pendulum')).json()).spec;
+              const box = document.createElement('div');
+              document.querySelector('main').append(box);
+              m.mountPrecision(box, { spec, getState: () => ({ initial: { theta: 1.0 } }) });
+            }"""
+        )
+        page.wait_for_selector("#precision .methods[data-ready='1']")
+        page.uncheck("#precision .methods input[value='euler']")
+        page.uncheck("#precision .methods input[value='DOP853']")
+        page.fill("#precision-step-from", "0.0125")
+        page.fill("#precision-step-to", "0.003125")
+        page.fill("#precision-count", "3")
+        page.click("#precision-run")
+        page.wait_for_selector("#precision[data-state='done']", timeout=90_000)
+        fitted = page.inner_text("#precision-orders tr[data-method='rk4'] .fitted")
+        assert abs(float(fitted) - 4) <= 0.3
+    finally:
+        ctx.close()
