@@ -47,8 +47,9 @@ export function logRange(a, b, n) {
 
 const num = (x, digits = 3) => (x === null || x === undefined ? "–" : Math.abs(x) >= 1e-2 && Math.abs(x) < 1e4 ? Number(x.toPrecision(digits)).toString() : x.toExponential(digits - 1));
 
-function logLayout(title, x, y) {
+function logLayout(title, x, y, ink) {
   return {
+    font: { color: ink }, // the page's text colour: lecture mode's dark theme too
     title: { text: title, font: { size: 14 }, x: 0.02, xanchor: "left" },
     margin: { l: 62, r: 14, t: 40, b: 52 },
     legend: { orientation: "h", y: -0.3, font: { size: 11 } },
@@ -170,6 +171,7 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
 
   function draw(result) {
     const P = window.Plotly;
+    const ink = getComputedStyle(root).color;
     const traces = (x, y) => result.methods.map((m, i) => {
       const pts = m.points.filter((p) => p[y] > 0 && p[x] > 0);
       return {
@@ -179,16 +181,16 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
         text: pts.map((p) => `${m.kind === "fixed" ? "h" : "tol"} = ${num(p.setting)}${p.excluded ? ` (left out: ${p.excluded})` : ""}`),
       };
     });
-    P.react("precision-plot-time", traces("wall_time", "error"), logLayout("error against wall time", "wall time (s)", "max |y − y_ref|"), CONFIG);
-    P.react("precision-plot-evals", traces("rhs_evaluations", "error"), logLayout("error against RHS evaluations", "RHS evaluations", "max |y − y_ref|"), CONFIG);
-    P.react("precision-plot-energy", traces("rhs_evaluations", "energy_error"), logLayout("energy error against RHS evaluations", "RHS evaluations", "|ΔE| / max T"), CONFIG);
+    P.react("precision-plot-time", traces("wall_time", "error"), logLayout("error against wall time", "wall time (s)", "max |y − y_ref|", ink), CONFIG);
+    P.react("precision-plot-evals", traces("rhs_evaluations", "error"), logLayout("error against RHS evaluations", "RHS evaluations", "max |y − y_ref|", ink), CONFIG);
+    P.react("precision-plot-energy", traces("rhs_evaluations", "energy_error"), logLayout("energy error against RHS evaluations", "RHS evaluations", "|ΔE| / max T", ink), CONFIG);
     if (result.long_run) {
       const lr = result.long_run;
       const data = Object.entries(lr.runs).map(([name, r], i) => ({
         x: r.t, y: r.energy_error, name: name === "rk4" ? "RK4" : "symplectic Euler", mode: "lines",
         line: { color: COLORS[(i + 3) % COLORS.length] },
       }));
-      const layout = logLayout("energy error over the long run (largest in each window)", "t (s)", "|ΔE| / max T");
+      const layout = logLayout("energy error over the long run (largest in each window)", "t (s)", "|ΔE| / max T", ink);
       layout.xaxis.type = "linear";
       P.react("precision-plot-long", data, layout, CONFIG);
     }

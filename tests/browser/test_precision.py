@@ -110,6 +110,15 @@ def test_run_shows_fitted_orders_near_the_textbook_orders(panel_page):
     assert not errors, errors
 
 
+def test_axe_finds_nothing_serious_in_the_panel(panel_page):
+    from axe_playwright_python.sync_playwright import Axe
+
+    page, _ = panel_page
+    found = Axe().run(page, context="#precision").response["violations"]
+    serious = [f"{v['id']}: {v['help']}" for v in found if v["impact"] in ("serious", "critical")]
+    assert serious == []
+
+
 def test_a_refused_request_is_shown_in_words(panel_page):
     page, errors = panel_page
     page.fill("#precision-step-from", "1e-7")  # t_end / step past 200000 steps
