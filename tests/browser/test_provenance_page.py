@@ -1,0 +1,56 @@
+"""static/js/provenance.js on a real scene page: traceTerms() adds a "where each term comes from"
+table under T, V, each Q_j and each equation of motion, typeset; hovering the polar Coriolis term
+lights it and the term of T it was differentiated from. The provenance is computed here with the
+engine and handed to the module, so the page part is tested before the derive response carries it.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from mechanics.derive import derivation_of_scene
+from mechanics.provenance import provenance_json
+
+pytestmark = pytest.mark.browser
+
+
+def test_trace_terms_tables_and_hover(server, page, artifacts):
+    p = page.page
+    p.goto(f"{server}/scenes/central_force")
+    p.wait_for_selector("#steps[data-typeset='1']", state="attached", timeout=90_000)
+    prov = provenance_json(derivation_of_scene("central_force"))
+    added = p.evaluate(
+        """async (prov) => {
+            const m = await import('/static/js/provenance.js');
+            const panels = await m.traceTerms(document.getElementById('steps'), prov);
+            panels.forEach((d) => { d.open = true; });
+            return panels.length;
+        }""",
+        prov,
+    )
+    # T and V, Q_r and Q_θ, the EoM of r and of θ: one panel under each line.
+    assert added == 6
+    assert p.locator("li[data-step=energy] .pv-panel").count() == 2
+    assert p.locator("li[data-step=lagrange] .pv-panel").count() == 2
+    assert p.locator(".pv-panel mjx-container").count() > 10  # typeset, not LaTeX source
+    # The Coriolis term 2 m r ṙ θ̇ of the θ equation: from the ê_θ component, through d/dt ∂T/∂θ̇.
+    [coriolis] = [
+        t for t in prov["eom"]["theta"]["lhs"]["terms"] if t["plain"] == "2*m*r*r_dot*theta_dot"
+    ]
+    via = coriolis["sources"][0]["via"]
+    row = p.locator(f"li[data-step=lagrange] tbody[data-term='{coriolis['id']}']")
+    assert "component of v of planet" in row.inner_text()
+    row.scroll_into_view_if_needed()
+    row.hover()
+    assert "pv-lit" in row.get_attribute("class")
+    origin = p.locator(f"li[data-step=energy] tbody[data-term='{via}']")
+    assert "pv-from" in origin.get_attribute("class")
+    p.screenshot(path=str(artifacts / "provenance_central_force.png"))
+    # A click keeps it lit after the pointer leaves; a second click lets go.
+    row.click()
+    p.mouse.move(2, 2)
+    assert "pv-lit" in row.get_attribute("class")
+    row.click()
+    p.mouse.move(2, 2)
+    assert "pv-lit" not in row.get_attribute("class")
+    assert not page.errors
