@@ -186,7 +186,9 @@ async def post_precision(body: PrecisionIn, http: Request) -> Response:
                 SECONDS,
                 affinity=spec_key,
                 what="the work–precision runs of this scene",
-                seconds=derive_seconds() + SECONDS + 10.0,  # derivation, runs, long run
+                # the derivation's own budget, then the runs', the long run's 8 s, the 2 s run that
+                # finds its period, and building the scene's C for the reference
+                seconds=derive_seconds() + SECONDS + 15.0,
             )
             return _encoded(result)
 
