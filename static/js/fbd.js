@@ -15,6 +15,16 @@ export const FORCE_COLORS = {
 const W = 440;
 const analysed = new WeakMap(); // result -> its SceneGeometry: the diagram redraws often
 
+let measurer = null;
+/** The width (px) of a label's text as the diagram sets it (italic, semi-bold), measured: an
+ * estimate from the character count puts "damper" on top of its neighbour. */
+function textWidth(text, px) {
+  if (!text) return 0;
+  measurer = measurer || document.createElement("canvas").getContext("2d");
+  measurer.font = `italic 600 ${px}px system-ui, sans-serif`;
+  return measurer.measureText(text).width;
+}
+
 /** `\vec{F}_{\text{spring}}` → {text: "F", sub: "spring"}. */
 export function labelParts(latex) {
   const m = latex.match(/^\s*(?:\\vec\{([^}]*)\}|([A-Za-z]+))\s*(?:_\{?(?:\\text\{|\\mathrm\{)?([^{}]*)\}?\}?)?/);
@@ -89,8 +99,8 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   // labels after every arrow is down, each just beyond its arrow's tip where that is free
   for (const { tip, d, text, sub, color } of labels) {
     const before = shapes.length;
-    const width = 0.62 * 13 * text.length + 0.6 * 13 * 0.75 * sub.length + 2;
-    placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, 13, { width, toward: d });
+    const width = 1.06 * (textWidth(text, 13) + textWidth(sub, 13 * 0.75)) + 3;
+    placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, 13, { width, toward: d, below: sub ? 7 : 4 });
     const label = shapes[before];
     Object.assign(label, { text, sub, italic: true, weight: 600 });
   }

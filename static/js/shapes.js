@@ -383,29 +383,38 @@ function shade(hex) {
  * first try the spot just beyond its tip).
  */
 export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 12, opts = {}) {
-  const tw = opts.width ?? 0.6 * size * text.length, th = size;
+  // the box a rendered label takes: its ascent above the baseline, `below` under it (the
+  // descent, and a subscript's drop when there is one)
+  const tw = opts.width ?? 0.6 * size * text.length, th = size, below = opts.below ?? 3;
   const g = r + 4;
   const tries = [[g, -g], [g, g + th * 0.6], [-g - tw, -g], [-g - tw, g + th * 0.6], [-tw / 2, -g - 4], [-tw / 2, g + th]];
   if (opts.toward) {
     const [dx, dy] = opts.toward;
-    tries.unshift([dx * (g + tw / 2) - tw / 2, dy * (g + th / 2) + th / 2]);
+    tries.unshift([dx * (g + tw / 2) - tw / 2, dy * (g + (th + below) / 2) + th / 2]);
   }
-  const optional = opts.optional;
+  // then farther out, in eight directions, before giving up on a free spot
+  for (let k = 1; k <= 5; k++) {
+    for (let a = 0; a < 8; a++) {
+      const ux = Math.cos((a * Math.PI) / 4), uy = -Math.sin((a * Math.PI) / 4);
+      const cx = x + ux * (g + 9 * k + (tw / 2) * Math.abs(ux)), cy = y + uy * (g + 9 * k + (th / 2) * Math.abs(uy));
+      tries.push([cx - tw / 2 - x, cy + th / 2 - y]);
+    }
+  }
   let pick = null;
   for (const [dx, dy] of tries) {
-    const box = [x + dx, y + dy - th, x + dx + tw, y + dy + 2];
+    const box = [x + dx, y + dy - th, x + dx + tw, y + dy + below];
     if (box[0] < 0 || box[2] > w || box[1] < 0 || box[3] > h) continue;
     if (occupied.some((o) => box[0] < o[2] && box[2] > o[0] && box[1] < o[3] && box[3] > o[1])) continue;
     pick = box;
     break;
   }
-  if (!pick && optional) return;
+  if (!pick && opts.optional) return;
   if (!pick) {
-    const left = Math.min(Math.max(0, x + g), w - tw), top = Math.min(Math.max(0, y - g - th), h - th - 2);
-    pick = [left, top, left + tw, top + th + 2];
+    const left = Math.min(Math.max(0, x + g), w - tw), top = Math.min(Math.max(0, y - g - th), h - th - below);
+    pick = [left, top, left + tw, top + th + below];
   }
   occupied.push(pick);
-  out.push({ t: "text", at: [pick[0], pick[3] - 2], text, color, size, halo: true });
+  out.push({ t: "text", at: [pick[0], pick[3] - below], text, color, size, halo: true });
 }
 
 function scaleBar(view, out, size) {

@@ -205,3 +205,37 @@ def test_a_rolling_disk_is_followed_at_one_readable_scale(server, page):
     assert max(scales) == min(scales)  # no zooming out while it travels
     assert R * scales[0] >= 25  # px: a disk, not a dot
     assert page.errors == []
+
+
+#: Pairs of <text> in an SVG whose rendered boxes overlap by more than a sliver.
+OVERLAPPING_TEXT = """svg => {
+  const boxes = [...svg.querySelectorAll('text')].map(t => [t.textContent, t.getBBox()]);
+  const out = [];
+  for (let i = 0; i < boxes.length; i++) for (let j = i + 1; j < boxes.length; j++) {
+    const [a, p] = boxes[i], [b, q] = boxes[j];
+    const w = Math.min(p.x + p.width, q.x + q.width) - Math.max(p.x, q.x);
+    const h = Math.min(p.y + p.height, q.y + q.height) - Math.max(p.y, q.y);
+    if (w > 1 && h > 1) out.push([a, b]);
+  }
+  return out;
+}"""
+
+
+@pytest.mark.parametrize("scene_id", ["spring_mass_damper", "coupled_oscillators"])
+def test_spring_and_damper_labels_do_not_overlap(server, page, scene_id):
+    p = page.page
+    p.goto(f"{server}/scenes/{scene_id}")
+    p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
+    page.settle()
+    pause(p)
+    for permille in (0, 333, 666):  # the diagram at a few instants, each force named once
+        p.eval_on_selector(
+            "#scrub", "(s, v) => { s.value = v; s.dispatchEvent(new Event('input')); }", permille
+        )
+        p.wait_for_timeout(300)
+        assert p.locator("#fbd-svg text").count() >= 4  # forces and the body's name
+        assert p.eval_on_selector("#fbd-svg", OVERLAPPING_TEXT) == []
+    p.goto(server)  # the catalog's drawing names springs and dampers only where they fit
+    p.wait_for_selector(f"svg[data-thumb='{scene_id}'][data-ready='1']", timeout=60_000)
+    assert p.eval_on_selector(f"svg[data-thumb='{scene_id}']", OVERLAPPING_TEXT) == []
+    assert page.errors == []
