@@ -102,6 +102,23 @@ class EomProvenance(BaseModel):
     rhs: TracedEquation
 
 
+class ForcingTerms(BaseModel):
+    """f_j of M q̈ = f by term ids: Σ `plus` (the EoM's right side) − Σ `minus` (its left-side
+    terms free of q̈)."""
+
+    minus: list[str]
+    plus: list[str]
+
+
+class MatrixProvenance(BaseModel):
+    """The mass-matrix form by term ids of the equations of motion (null rows: not traced)."""
+
+    M: list[list[list[str]] | None] = Field(
+        description="M[j][k]: the ids of EoM j's terms whose sum is M_jk q̈_k."
+    )
+    f: list[ForcingTerms | None]
+
+
 class Provenance(BaseModel):
     """Where every term comes from: T, V, Q_j and each equation of motion, term by term."""
 
@@ -113,3 +130,4 @@ class Provenance(BaseModel):
     V: TracedEquation
     Q: dict[str, TracedEquation] = Field(description="Q_j per coordinate.")
     eom: dict[str, EomProvenance] = Field(description="Per coordinate.")
+    matrix: MatrixProvenance

@@ -429,7 +429,9 @@ def trace(displayed: sp.Expr, contributions: list[Contribution], model: Any) -> 
             whole = sp.Add(*ds)
             split = [(whole, [(c, s * mono) for c, s in shares])]
         for d, parts in split:
-            terms.append(_term_json(d, parts, model))
+            term = _term_json(d, parts, model)
+            term["_monomial"] = mono  # plain; for the matrix form, dropped from the JSON
+            terms.append(term)
     cancelled = []
     for mono in {m for _, by in per_contribution for m in by} - set(groups):
         parts = [(c, by[mono] * mono) for c, by in per_contribution if by.get(mono, 0) != 0]
@@ -500,8 +502,9 @@ def provenance(derivation: Any) -> dict[str, Any]:
     """Every traced equation of a derivation: T, V, Q_j and each EoM (see the module docstring).
 
     {"origins": {id: origin}, "T": eq, "V": eq, "Q": {name: eq}, "eom": {name: {"lhs": eq,
-    "rhs": eq}}}; an eq is {"traced", "terms", "cancelled"} (and "reason" when not traced); a
-    term's sources name their origin by id (T1…, V1…, Q<j>.<i>), described once in ``origins``."""
+    "rhs": eq}}, "matrix": {"M": ..., "f": ...} (see `matrix_form`)}; an eq is {"traced",
+    "terms", "cancelled"} (and "reason" when not traced); a term's sources name their origin by
+    id (T1…, V1…, Q<j>.<i>), described once in ``origins``."""
     model, work = derivation.model, derivation.work
     kin, pot = kinetic_origins(model), potential_origins(model)
     names = model.coordinate_names
@@ -517,6 +520,7 @@ def provenance(derivation: Any) -> dict[str, Any]:
             "V": skip,
             "Q": dict.fromkeys(names, skip),
             "eom": {n: {"lhs": skip, "rhs": skip} for n in names},
+            "matrix": {"M": [None] * len(names), "f": [None] * len(names)},
         }
     table = {o.id: o.to_json() for o in (*kin, *pot)}
     T = trace(work.T, [Contribution(o, o.expr) for o in kin], model)
@@ -550,7 +554,38 @@ def provenance(derivation: Any) -> dict[str, Any]:
             "lhs": trace(work.eom_lhs[j], lhs, model),
             "rhs": trace(work.Q[j], [Contribution(o, o.expr, "Q") for o in forces], model),
         }
-    return {"origins": table, "T": T, "V": V, "Q": Q, "eom": eom}
+    return {
+        "origins": table,
+        "T": T,
+        "V": V,
+        "Q": Q,
+        "eom": eom,
+        "matrix": matrix_form(eom, model),
+    }
+
+
+def matrix_form(eom: dict[str, Any], model: Any) -> dict[str, Any]:
+    """M q̈ = f by term ids: M_jk q̈_k is the sum of EoM j's terms whose monomial is q̈_k, and
+    f_j = Σ its right side − Σ its left-side terms free of q̈ (M is linear in q̈ by construction,
+    and no EoM term multiplies q̈ by a velocity). None for an equation not traced."""
+    to_sym, _ = _symbols_for(model)
+    accelerations = [to_sym[a] for a in model.qdd]
+    M: list[list[list[str]] | None] = []
+    f: list[dict[str, list[str]] | None] = []
+    for name in model.coordinate_names:
+        lhs, rhs = eom[name]["lhs"], eom[name]["rhs"]
+        if not (lhs.get("traced") and rhs.get("traced")):
+            M.append(None)
+            f.append(None)
+            continue
+        M.append([[t["id"] for t in lhs["terms"] if t["_monomial"] == a] for a in accelerations])
+        f.append(
+            {
+                "minus": [t["id"] for t in lhs["terms"] if not t["_monomial"].has(*accelerations)],
+                "plus": [t["id"] for t in rhs["terms"]],
+            }
+        )
+    return {"M": M, "f": f}
 
 
 def _through(eq: dict[str, Any], origins: list[Origin], model: Any) -> list[tuple]:
@@ -577,7 +612,7 @@ def provenance_json(derivation: Any) -> dict[str, Any]:
 
 def _strip(value: Any) -> Any:
     if isinstance(value, dict):
-        return {k: _strip(v) for k, v in value.items() if k != "_expr"}
+        return {k: _strip(v) for k, v in value.items() if k not in ("_expr", "_monomial")}
     if isinstance(value, list):
         return [_strip(v) for v in value]
     return value

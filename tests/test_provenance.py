@@ -69,6 +69,18 @@ def check_sums(derivation) -> dict:
         whole = sp.Add(*(read(t["plain"]) for t in eom["lhs"]["terms"]))
         whole -= sp.Add(*(read(t["plain"]) for t in eom["rhs"]["terms"]))
         assert is_zero(whole - (derivation.work.eom_lhs[j] - derivation.work.Q[j])), n
+        # M q̈ = f by term ids: the q̈_k terms over q̈_k are M_jk; f_j = Σ plus − Σ minus.
+        lhs = {t["id"]: read(t["plain"]) for t in eom["lhs"]["terms"]}
+        rhs = {t["id"]: read(t["plain"]) for t in eom["rhs"]["terms"]}
+        for k, ids in enumerate(prov["matrix"]["M"][j]):
+            qdd = derivation.model.qdd[k]
+            entry = sp.Add(*(lhs[i] for i in ids)) / qdd
+            assert is_zero(entry - derivation.work.mass_matrix[j, k]), (n, k)
+        f = prov["matrix"]["f"][j]
+        forcing = sp.Add(*(rhs[i] for i in f["plus"])) - sp.Add(*(lhs[i] for i in f["minus"]))
+        assert is_zero(forcing - derivation.work.forcing[j]), n
+        listed = {i for ids in prov["matrix"]["M"][j] for i in ids} | set(f["minus"])
+        assert listed == set(lhs), n  # every left-side term is in M or in f
     return prov
 
 
