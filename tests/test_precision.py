@@ -18,7 +18,13 @@ from app import derivations
 from app.errors import register_error_handlers
 from app.routes import precision as route
 from mechanics.numeric import compiled_scene
-from mechanics.precision import PrecisionRequest, long_run, precision
+from mechanics.precision import (
+    PrecisionRequest,
+    fitted_order,
+    leave_out_pre_asymptotic,
+    long_run,
+    precision,
+)
 from mechanics.scenes import load_scene, scene_ids
 
 api = FastAPI()
@@ -94,6 +100,43 @@ def test_dop853_fitted_order_against_work_is_eight_on_the_pendulum():
     # tighter tolerance: more work, smaller error
     evals = [p["rhs_evaluations"] for p in dop["points"]]
     assert evals == sorted(evals)
+
+
+def test_the_fit_is_the_slope_of_a_power_law():
+    h = [0.1, 0.05, 0.02, 0.01]
+    assert fitted_order(h, [3 * x**2.5 for x in h]) == pytest.approx(2.5)
+    assert fitted_order([1000, 2000], [1e-3, 1e-3 / 2**8]) == pytest.approx(-8)
+    assert fitted_order([0.1], [1.0]) is None
+
+
+def test_coarse_points_still_creeping_towards_p_are_left_out():
+    # err = h⁴ (1 − 5h), as RK4's on the pendulum, approaching p from below: local slopes
+    # 4 + log2((1 − 10x)/(1 − 5x)) for a pair (2x, x) = 3.42, 3.78, 3.90, 3.95, 3.98: the first
+    # differs from the next by 0.36 (> 5 %), the second from the third by 0.12 (< 5 %)
+    h = [0.1 / 2**k for k in range(6)]
+    points = [{"h": x, "error": x**4 * (1 - 5 * x), "excluded": None} for x in h]
+    leave_out_pre_asymptotic(points)
+    assert points[0]["excluded"].startswith("not yet asymptotic")
+    assert [p["excluded"] for p in points[1:]] == [None] * 5
+    everything = fitted_order(h, [p["error"] for p in points])
+    kept = fitted_order(h[1:], [p["error"] for p in points[1:]])
+    assert abs(kept - 4) < abs(everything - 4)
+
+
+def test_euler_energy_error_is_the_closed_form_growth_of_the_linear_oscillator():
+    # Euler on y' = iωy multiplies y by 1 + iν, the energy by 1 + ν² a step (ν = ωh): after N
+    # steps E = E₀(1 + ν²)ᴺ. From rest at θ₀ = 1e-3 (linear), T peaks at q = 0, a quarter
+    # period in (t ≈ 0.50 s, N/2 steps), so |ΔE|/max T = ((1 + ν²)ᴺ − 1)/(1 + ν²)^(N/2).
+    result = precision(
+        "simple_pendulum",
+        request=PrecisionRequest(
+            methods=["euler"], initial={"theta": 1e-3}, t_end=1.0, steps=[1e-3]
+        ),
+    )
+    (point,) = fitted(result, "euler")["points"]
+    nu2 = 9.81 * 1e-3**2
+    expected = ((1 + nu2) ** 1000 - 1) / (1 + nu2) ** 500
+    assert point["energy_error"] == pytest.approx(expected, rel=2e-3)
 
 
 def test_points_at_the_floor_or_not_converging_are_shown_but_left_out():
