@@ -17,7 +17,17 @@ from app.errors import register_error_handlers
 from app.middleware import BodyLimit, HeadAsGet, SecurityHeaders
 from app.paths import STATIC_DIR, api_docs_dir, mathjax_dir, plotly_dir
 from app.responses import ORJSONResponse
-from app.routes import check, derive, equilibria, export, newton, pages, scenes, simulate
+from app.routes import (
+    check,
+    derive,
+    equilibria,
+    export,
+    newton,
+    pages,
+    precision,
+    scenes,
+    simulate,
+)
 from app.schemas import Health
 
 #: A request body past this is refused unread: no honest scene comes near it.
@@ -53,6 +63,7 @@ app.include_router(check.router)
 app.include_router(equilibria.router)
 app.include_router(newton.router)
 app.include_router(export.router)
+app.include_router(precision.router)
 app.include_router(pages.router)
 register_error_handlers(app)
 
