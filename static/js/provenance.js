@@ -46,6 +46,28 @@ function sourceCells(source, origins, q) {
   ];
 }
 
+/** The derivation's lines a source stands on, as [step id, line label] (derivation.js labels):
+ * the body's velocity and T, the spring's or potential's V, the load's Q_j, and the pieces of the
+ * Euler–Lagrange equation it passes through. */
+function linesOf(source, origins, q) {
+  const o = origins[source.origin] || {};
+  const out = [];
+  if (o.kind === "kinetic") {
+    const links = new Set((o.components || []).map((c) => c.link).filter(Boolean));
+    if (o.motion === "rotational") out.push(["kinematics", `angular velocity of ${o.body}`]);
+    else for (const link of links.size ? links : [o.body]) out.push(["kinematics", `v of ${link}`]);
+    out.push(["kinematics", `v of ${o.body}`], ["energy", `T_${o.body}`], ["energy", "T"]);
+  } else if (o.kind === "potential") {
+    out.push(["energy", `V_${o.name}`], ["energy", "V"]);
+  } else if (o.kind === "generalized force") {
+    out.push(["forces", `Q_${o.coordinate}`]);
+  }
+  if (q && source.piece === "d/dt ∂T/∂q̇") out.push(["lagrange", `dL/d${q}_dot`], ["lagrange", `d/dt dL/d${q}_dot`]);
+  if (q && (source.piece === "−∂T/∂q" || source.piece === "∂V/∂q")) out.push(["lagrange", `dL/d${q}`]);
+  if (q) out.push(["lagrange", `EoM ${q}`]);
+  return out;
+}
+
 /** One table: a <tbody> per term (its id, the ids it came through), a row per source. */
 function table(eq, origins, q, side) {
   if (!eq || !eq.traced) {
@@ -66,6 +88,8 @@ function table(eq, origins, q, side) {
     body.dataset.term = term.id;
     body.dataset.via = [...new Set(term.sources.map((s) => s.via).filter(Boolean))].join(" ");
     body.title = `${term.plain}: click to keep it lit`;
+    const lines = term.sources.flatMap((source) => linesOf(source, origins, q));
+    body.dataset.lines = JSON.stringify([...new Map(lines.map((l) => [l.join("\u0000"), l])).values()]);
     term.sources.forEach((source, k) => {
       const row = el("tr");
       if (k === 0) {
@@ -109,9 +133,15 @@ function lineOf(container, stepId, label) {
   return row || null;
 }
 
-/** Light a term everywhere: the same id (.pv-lit), the terms it came through (.pv-from) and the
- * terms derived from it (.pv-into). */
+/** Light a term everywhere: the same id (.pv-lit), the terms it came through (.pv-from), the
+ * terms derived from it (.pv-into) and the derivation's lines its origins stand on (.pv-line). */
 function light(container, body, on) {
+  for (const row of container.querySelectorAll(".math-line.pv-line")) row.classList.remove("pv-line");
+  if (on) {
+    for (const [stepId, label] of JSON.parse(body.dataset.lines || "[]")) {
+      lineOf(container, stepId, label)?.classList.add("pv-line");
+    }
+  }
   const id = body.dataset.term;
   const vias = (body.dataset.via || "").split(" ").filter(Boolean);
   for (const other of container.querySelectorAll("tbody.pv-term")) {
@@ -166,6 +196,7 @@ const STYLE = `
 .pv-term.pv-into { background: rgba(26, 127, 55, .14); }
 .pv-term.pv-pinned { box-shadow: inset 3px 0 0 var(--accent, #1a63d6); }
 .pv-untraced { font-size: .82rem; }
+.math-line.pv-line { background: rgba(255, 214, 0, .18); box-shadow: inset 3px 0 0 rgba(214, 160, 0, .9); }
 @media (max-width: 640px) { .pv-panel { margin-left: 0; } .pv-table .pv-origin { font-size: .78rem; }
   .pv-table, .pv-table tbody, .pv-table tr { display: block; } .pv-table thead { display: none; }
   .pv-table td { display: inline-block; border: 0; } .pv-table tbody { border-bottom: 1px solid var(--line, #dde2e9); } }

@@ -45,6 +45,13 @@ def test_trace_terms_tables_and_hover(server, page, artifacts):
     assert "pv-lit" in row.get_attribute("class")
     origin = p.locator(f"li[data-step=energy] tbody[data-term='{via}']")
     assert "pv-from" in origin.get_attribute("class")
+    # ... and the lines it stands on, step by step: v of the planet, T, d/dt ∂L/∂θ̇, the EoM.
+    lit = p.eval_on_selector_all(
+        ".math-line.pv-line", "rows => rows.map(r => r.querySelector('.line-label').textContent)"
+    )
+    for label in ("v of planet", "T_planet", "T", "d/dt dL/dtheta_dot", "EoM theta"):
+        assert label in lit, lit
+    assert "V" not in lit and "EoM r" not in lit
     p.screenshot(path=str(artifacts / "provenance_central_force.png"))
     # A click keeps it lit after the pointer leaves; a second click lets go.
     row.click()
