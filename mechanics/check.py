@@ -28,6 +28,8 @@ from mechanics.steps import tidy
 QUANTITIES = ("T", "V", "L", "Q", "eom", "accel", "momentum")
 PER_COORDINATE = {"Q", "eom", "accel", "momentum"}
 SAMPLES = 12
+MAX_UNIT_LINES = 4
+MAX_TERMS = 40  # past this many monomials, feedback term by term would not help anyone
 TOLERANCE = 1e-9
 
 
@@ -99,6 +101,14 @@ def _latex(d: Derivation, quantity: str, j: int | None) -> str:
 def inline(expr: sp.Expr) -> str:
     """Inline math for a feedback sentence: `$\\frac{g}{l} \\sin\\theta$` (the page renders it)."""
     return f"${to_latex(expr)}$"
+
+
+def _as_written(term: sp.Expr) -> str:
+    """A term of the answer as the student wrote it (no tidying: a power of a sum stays one);
+    a term too big to read is named by its shape."""
+    if sp.count_ops(term) > 40:
+        return "you wrote as a long expression" if not term.is_Pow else "that is a power of a sum"
+    return inline(term)
 
 
 class _Judge:
@@ -241,7 +251,7 @@ class _Judge:
         """The factor the student's equation carries over the derived one, read from the terms
         both have: that of the q̈ term when it has the same form in both, else the commonest."""
         g, e = self._canonical(given), self._canonical(expected)
-        if len(g) + len(e) > 40:
+        if len(g) + len(e) > MAX_TERMS:
             return None
         ratios = {mono: sp.simplify(g[mono] / e[mono]) for mono in e if mono in g}
         if not ratios:
@@ -279,11 +289,13 @@ class _Judge:
         for term in sp.Add.make_args(e):
             coeff, mono = term.as_independent(*dynamic, as_Add=False)
             out[mono] = out.get(mono, 0) + coeff
+        if len(out) > MAX_TERMS:  # no term-by-term story to tell; simplifying each would take s
+            return out
         return {k: v for k, v in out.items() if sp.simplify(v) != 0}
 
     def _terms(self, given: sp.Expr, expected: sp.Expr) -> list[str]:
         g, e = self._canonical(given), self._canonical(expected)
-        if len(g) + len(e) > 40:
+        if len(g) + len(e) > MAX_TERMS:
             return []
         fb = []
         for mono, coeff in e.items():
@@ -434,19 +446,27 @@ class _Judge:
             "eom": f"{units.fmt(want)} like the rest of the equation",
             "accel": f"{units.fmt(want)} (an acceleration of {inline(self.m.q[self.j or 0])})",
         }.get(self.quantity, units.fmt(want))
-        fb = []
-        for term in sp.Add.make_args(sp.expand(given)):
+        # the terms as written (a sum inside a power is one term that mixes units), and a few
+        # of them: a hostile (a + b + …)**30 must not become thousands of lines
+        wrong = []
+        for term in self._surface(given):
             if term == 0:  # "0" has every unit
                 continue
             have = units.dimension(term, dims)
+            if have != want:
+                wrong.append((term, have))
+        fb = []
+        for term, have in wrong[:MAX_UNIT_LINES]:
             if have is None:
                 fb.append(
-                    f"The term {self._show(term)} mixes units (e.g. a sum inside a power or "
+                    f"The term {_as_written(term)} mixes units (e.g. a sum inside a power or "
                     "a dimensional argument to a function)."
                 )
-            elif have != want:
+            else:
                 fb.append(
-                    f"The term {self._show(term)} has units {units.fmt(have)}, not {what}: "
+                    f"The term {_as_written(term)} has units {units.fmt(have)}, not {what}: "
                     "it cannot belong here."
                 )
+        if len(wrong) > MAX_UNIT_LINES:
+            fb.append(f"… and {len(wrong) - MAX_UNIT_LINES} more terms with the wrong units.")
         return fb
