@@ -215,3 +215,11 @@ def test_eom_terms_carried_across_are_each_named():
     )
     moved = [f for f in v.feedback if "carried across '='" in f]
     assert len(moved) == 2, v.feedback
+
+
+def test_a_power_of_a_sum_gets_one_line_not_one_per_expanded_term():
+    """(θ + θ̇ + m + 1)⁸ expands to 165 monomials: the feedback is about the term as written."""
+    v = verdict("simple_pendulum", "T", "(theta + theta_dot + m + 1)^8")
+    assert not v.correct
+    assert 1 <= len(v.feedback) <= 5, v.feedback
+    assert any("mixes units" in f and r"\right)^{8}" in f for f in v.feedback), v.feedback
