@@ -276,8 +276,12 @@ def on_scene(
     affinity = scene_id or key
     # judging an answer against a built-in scene's cached derivation takes milliseconds: a
     # shorter budget keeps a hostile answer from holding a worker for the derivation's 20 s
-    checking = getattr(job, "__name__", "") == "answer_check"
-    seconds = min(check_seconds(), derive_seconds()) if checking and scene_id else None
+    # (a prediction integrates two models as well: it keeps the derivation's budget), and past
+    # its budget the 503 is about the answer, not the scene
+    name = getattr(job, "__name__", "")
+    checking = name in ("answer_check", "answer_predict")
+    short = name == "answer_check" and scene_id is not None
+    seconds = min(check_seconds(), derive_seconds()) if short else None
 
     def compute() -> Any:
         return in_pool(
