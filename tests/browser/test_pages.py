@@ -325,7 +325,7 @@ def test_equilibria_are_listed_and_drawn(server, page):
         " && [...document.querySelectorAll('#equilibria svg.eq-sketch')]"
         ".every(s => s.dataset.ready === '1')"
     )
-    assert "acos" in p.inner_text("#equilibria")
+    assert "arccos" in p.inner_text("#equilibria")  # typeset math, not acos( code
     assert page.errors == []
 
 
