@@ -28,7 +28,7 @@ from app.routes import (
     scenes,
     simulate,
 )
-from app.schemas import Health
+from app.schemas import Health, WarmUp
 
 #: A request body past this is refused unread: no honest scene comes near it.
 MAX_BODY_BYTES = 1024 * 1024
@@ -95,4 +95,6 @@ app.state.assets = assets
 @app.get("/healthz", response_model=Health, tags=["health"])
 def healthz() -> Health:
     """Liveness for load balancers and CI: answers without touching the engine."""
-    return Health(version=__version__)
+    from app.derivations import warm_state
+
+    return Health(version=__version__, warm=WarmUp(**warm_state))

@@ -46,9 +46,18 @@ class ValidationErrors(BaseModel):
 Message = ValidationErrors
 
 
+class WarmUp(BaseModel):
+    """How far this server process is in making every built-in scene ready (app/derivations.py)."""
+
+    done: int = Field(description="Built-in scenes made ready so far.")
+    of: int = Field(description="Built-in scenes to make ready (0: warming is off).")
+    seconds: float | None = Field(description="How long it took, once all are ready.")
+
+
 class Health(BaseModel):
     status: str = "ok"
     version: str
+    warm: WarmUp | None = Field(default=None, description="The start-up warming of this process.")
 
 
 class SceneSummary(BaseModel):

@@ -263,8 +263,15 @@ async def crowd(base: str, students: int, think: float, duration: float, hostile
 
 async def warm_up(base: str) -> None:
     """Every built-in scene once (derivation, compiled C, page), as the first students of a class
-    would leave it: the crowd measures a warm server."""
+    would leave it, after the server's own start-up warming is over in every worker process (as
+    before a lecture): the crowd measures a warm server."""
     async with httpx.AsyncClient(base_url=base, timeout=120.0) as http:
+        deadline, ready_in_a_row = time.monotonic() + 600, 0
+        while ready_in_a_row < 20 and time.monotonic() < deadline:  # 20: every worker answered
+            warm = (await http.get("/healthz")).json().get("warm") or {}
+            ready = warm.get("done", 0) >= warm.get("of", 0)
+            ready_in_a_row = ready_in_a_row + 1 if ready else 0
+            await asyncio.sleep(0.05 if ready else 1.0)
         scenes = [s["id"] for s in (await http.get("/api/v1/scenes")).json()]
         for scene_id in scenes:
             await http.get(f"/scenes/{scene_id}")
