@@ -115,7 +115,8 @@ function table(eq, origins, q, side) {
     });
     t.append(body);
   }
-  return t;
+  // wide math (lecture mode's big type) scrolls inside its box, never the page
+  return el("div", { className: "pv-scroll" }, t);
 }
 
 function panel(title, parts) {
@@ -182,7 +183,8 @@ function wire(container) {
 }
 
 const STYLE = `
-.pv-panel { margin: .15rem 0 .5rem 1rem; font-size: .9rem; }
+.pv-panel { margin: .15rem 0 .5rem 1rem; font-size: .9rem; min-width: 0; max-width: 100%; }
+.pv-scroll { overflow-x: auto; max-width: 100%; }
 .pv-panel > summary { cursor: pointer; color: var(--muted, #5b6575); font-size: .82rem; }
 .pv-table { border-collapse: collapse; margin: .3rem 0; width: 100%; }
 .pv-table caption { text-align: left; font-size: .8rem; color: var(--muted, #5b6575); }
