@@ -10,6 +10,7 @@ parameters swapped, q mixed up with q̇) and the units of every term are checked
 
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import dataclass, field
 from typing import Any
@@ -49,6 +50,30 @@ class Verdict:
         if reveal:
             out["expected_latex"] = self.expected_latex
         return out
+
+
+def _expansion_size(expr: sp.Expr, cap: int) -> int:
+    """An upper estimate of how many terms expanding ``expr`` (products, integer powers of sums,
+    trig of sums) gives, saturating past ``cap``: decided from the tree, without expanding."""
+    if expr.is_Atom:
+        return 1
+    if isinstance(expr, sp.Add):
+        return min(cap + 1, sum(_expansion_size(a, cap) for a in expr.args))
+    if isinstance(expr, sp.Mul):
+        size = 1
+        for a in expr.args:
+            size = min(cap + 1, size * _expansion_size(a, cap))
+        return size
+    if isinstance(expr, sp.Pow):
+        n = expr.exp
+        if not (n.is_Integer and n > 1):
+            return 1  # (a + b)⁻² or √(a + b) stays one term
+        k = _expansion_size(expr.base, cap)
+        return 1 if k == 1 else min(cap + 1, math.comb(int(min(n, 10**4)) + k - 1, k - 1))
+    if isinstance(expr, sp.Function):
+        k = max((_expansion_size(a, cap) for a in expr.args), default=1)
+        return min(cap + 1, 2 ** min(k, 20))  # sin(a + b + …) expands into products
+    return 1
 
 
 def expected_quantity(d: Derivation, quantity: str, j: int | None) -> sp.Expr:
@@ -281,7 +306,14 @@ class _Judge:
             fb.append("Not equal to the derived result at the states sampled.")
 
     def _canonical(self, expr: sp.Expr) -> dict[sp.Expr, sp.Expr]:
-        """monomial in q, q̇, q̈, trig(q), t -> its coefficient (parameters only)."""
+        """monomial in q, q̇, q̈, trig(q), t -> its coefficient (parameters only).
+
+        An answer whose expansion would run to thousands of terms ((θ + θ̇ + m + 1)³⁰: 5456)
+        is not expanded at all: it has no term-by-term story, and expanding it is what a hostile
+        answer counts on to hold a worker. It comes back as more than MAX_TERMS placeholders,
+        which every caller reads as 'too many terms'."""
+        if _expansion_size(expr, 8 * MAX_TERMS) > 8 * MAX_TERMS:
+            return {sp.Dummy(f"term{i}"): sp.S.One for i in range(MAX_TERMS + 1)}
         e = sp.expand(sp.expand_trig(sp.expand(expr)))
         e = sp.expand(TR5(e))
         dynamic = set(self.m.q) | set(self.m.qd) | set(self.m.qdd) | {t}

@@ -185,3 +185,29 @@ def test_springs_on_their_other_sides_cost_one_more_derivation(monkeypatch):
     result = run(spec, t_end=0.1, initial={"x": -3.0})
     assert result["stats"]["status"] == "ok"
     assert len(calls) == 2 and len(calls[1]) == 16
+
+
+def test_expansion_size_is_an_upper_estimate_exact_for_powers_of_sums():
+    """(a + b + c + 1)ⁿ expands to C(n + 3, 3) terms: the estimate says so without expanding."""
+    import sympy as sp
+
+    from mechanics.check import _expansion_size
+
+    a, b, c = sp.symbols("a b c")
+    for n in (2, 3, 5):
+        expr = (a + b + c + 1) ** n
+        actual = len(sp.Add.make_args(sp.expand(expr)))
+        assert actual == math.comb(n + 3, 3) == _expansion_size(expr, 10**6)
+    assert _expansion_size((a + b + c + 1) ** 30, 320) == 321  # saturates, never computes 5456
+
+
+@pytest.mark.timeout(60)
+def test_a_huge_power_answer_is_judged_without_expanding_it():
+    """(θ + θ̇ + m + 1)³⁰ as T took minutes of sympy expansion (5456 terms); it is judged wrong
+    at random states and its units are named without expanding it."""
+    from mechanics.check import check
+    from mechanics.jobs import derivation_of
+
+    verdict = check(derivation_of("elastic_pendulum", None), "T", "(theta + theta_dot + m + 1)**30")
+    assert verdict.correct is False
+    assert any("mixes units" in line for line in verdict.feedback)
