@@ -433,7 +433,9 @@ def trace(displayed: sp.Expr, contributions: list[Contribution], model: Any) -> 
             term["_monomial"] = mono  # plain; for the matrix form, dropped from the JSON
             terms.append(term)
     cancelled = []
-    for mono in {m for _, by in per_contribution for m in by} - set(groups):
+    # In order of first appearance, never a set's: the JSON must not depend on the hash seed.
+    seen = dict.fromkeys(m for _, by in per_contribution for m in by)
+    for mono in (m for m in seen if m not in groups):
         parts = [(c, by[mono] * mono) for c, by in per_contribution if by.get(mono, 0) != 0]
         if parts:
             cancelled.append(

@@ -204,3 +204,28 @@ def test_the_json_has_the_documented_shape(scene_id):
                 eom[side]["terms"], parsed["eom"][n][side]["terms"], strict=True
             ):
                 assert dumped["sources"] == term["sources"]
+
+
+def test_the_json_is_the_same_in_another_process():
+    """A derivation is a function of its spec (the cache shares it between processes): the
+    provenance must not depend on the hash seed (sets of sympy expressions iterate by hash)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import json; from mechanics.derive import derivation_of_scene; "
+        "from mechanics.provenance import provenance_json; "
+        "print(json.dumps(provenance_json(derivation_of_scene('double_pendulum')), sort_keys=True))"
+    )
+    outputs = set()
+    for seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        run = subprocess.run(
+            [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+        )
+        outputs.add(run.stdout)
+    assert len(outputs) == 1
+    mine = json.dumps(provenance_json(derivation_of_scene("double_pendulum")), sort_keys=True)
+    assert outputs == {mine + "\n"}
