@@ -87,21 +87,27 @@ def test_a_bead_on_a_spinning_parabola_rides_its_wire_and_the_wire_turns(server,
     p.wait_for_timeout(800)
     pieces = p.get_attribute("#canvas", "data-pieces").split()
     assert "wire" in pieces and "axis" in pieces and "spin" in pieces
-    for attempt in range(2):  # at two instants: the wire is where the frame has turned it
+    found = 0
+    # at two instants: the wire is where the frame has turned it (the bead and its name sit on
+    # it somewhere and hide a few of the points)
+    for attempt in range(2):
         pause(p)
         t = float(p.get_attribute("#instruments", "data-t"))
         cam = json.loads(p.get_attribute("#canvas", "data-camera"))
         c, s = math.cos(OMEGA * t), math.sin(OMEGA * t)
         # the wire at time t: r along H.x, a r^2 along H.y, H turned by Omega t about N.y
-        on = [(u * c, A * u * u, -u * s) for u in (-0.6, -0.5, -0.4, -0.3, 0.3, 0.4, 0.5, 0.6)]
+        us = [sign * (0.25 + 0.08 * k) for sign in (-1, 1) for k in range(6)]
+        on = [(u * c, A * u * u, -u * s) for u in us]
         below = [(u * c, -A * u * u - 0.1, -u * s) for u in (-0.6, -0.45, 0.45, 0.6)]
         hits = p.evaluate(GREY_NEAR, [[project(cam, q) for q in on]])
         misses = p.evaluate(GREY_NEAR, [[project(cam, q) for q in below]])
-        assert sum(hits) >= 7, (t, hits)
+        assert sum(hits) >= 8, (t, hits)
+        found += sum(hits)
         assert sum(misses) == 0, (t, misses)
         p.screenshot(path=str(artifacts / f"parabola-wire-{attempt}.png"))
         p.click("#play")
         p.wait_for_timeout(700)
+    assert found >= 19  # of 24
     assert page.errors == []
 
 
