@@ -471,6 +471,11 @@ def _split_group(
             parts.setdefault(home, []).append(arg)
         for i, args in parts.items():
             out[i][1].append((c, sp.Add(*args) * mono))
+    # Each piece must be exactly its parts (the keys could agree while a coefficient differs,
+    # e.g. a share the displayed form cancelled): otherwise keep the monomial whole.
+    for d, parts in out:
+        if not parts or canonical(d - sp.Add(*(e for _, e in parts))) != 0:
+            return None
     return out
 
 
