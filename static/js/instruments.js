@@ -36,11 +36,18 @@ export class Instruments {
     this.spec = null;
     this.watch = { running: false, elapsed: 0, last: null };
     this.box = el("div", { className: "instruments", id: "instruments" },
-      "display:flex;flex-wrap:wrap;gap:8px;margin-top:8px;align-items:stretch");
+      "display:flex;flex-wrap:wrap;gap:8px;align-items:stretch");
     this.box.setAttribute("aria-label", "instruments");
+    // a fold like the page's other sections (app.css .fold), closed at first on a phone, where
+    // the animation and the derivation come first
+    const fold = el("details", { className: "fold instruments-fold", open: !window.matchMedia("(max-width: 600px)").matches },
+      "margin-top:6px");
+    const summary = el("summary");
+    summary.append(el("h2", { textContent: "Instruments" }, "font-size:1rem"));
+    fold.append(summary, this.box);
     const section = stage.canvas.closest("section") || stage.canvas.parentElement;
     const playback = section.querySelector(".playback");
-    (playback || section.lastElementChild).after(this.box);
+    (playback || section.lastElementChild).after(fold);
     this.#stepButtons(playback);
     this.#energyPanel();
     this.#clocks();
