@@ -12,6 +12,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, StringConstraints, model_validator
 from pydantic_core import PydanticCustomError
 
+from app.provenance_schema import Provenance
 from mechanics.check import QUANTITIES
 from mechanics.integrators import METHODS
 from mechanics.spec import SceneSpec
@@ -153,6 +154,12 @@ class DeriveResponse(BaseModel):
     warnings: list[str] = Field(description="What the engine could not simplify, and similar.")
     seconds: float | None = Field(
         default=None, description="How long the derivation took when it was computed."
+    )
+    provenance: Provenance | None = Field(
+        default=None,
+        description="Where every term of T, V, Q_j and each equation of motion comes from: "
+        "which body, velocity component, force or piece of Lagrange's equations "
+        "(docs/provenance.md).",
     )
 
 

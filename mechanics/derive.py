@@ -18,6 +18,7 @@ from mechanics import cache
 from mechanics.degenerate import check_mass_matrix
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model, build_model
+from mechanics.provenance import provenance_json
 from mechanics.scenes import load_scene
 from mechanics.spec import SceneSpec, parse_spec
 from mechanics.steps import Step, Work, unsimplified
@@ -93,6 +94,7 @@ class Derivation:
             "latex": self.equations(to_latex),
             "warnings": list(self.work.warnings),
             "seconds": round(self.seconds, 4),
+            "provenance": provenance_json(self),
         }
 
 
