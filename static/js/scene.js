@@ -15,13 +15,17 @@ import { showEquilibria } from "./equilibria.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
 import { isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
 import { Lecture } from "./lecture.js";
-import { LiveModel, PREVIEW_LABEL } from "./live.js";
+import { LiveModel, PREVIEW_LABEL, forDisplay } from "./live.js";
 import { BodyDrag } from "./livedrag.js";
 import { loadPlotly } from "./lazy.js";
 import { plotRun, plotlyReady } from "./plots.js";
 import { showWork, watchWorkInputs } from "./work.js";
 
 const $ = (id) => document.getElementById(id);
+/** Samples per second asked of the server, and how many times that the animation draws (the
+ * frames between two samples are interpolated: live.js forDisplay). */
+const SERVER_FPS = 30;
+const DISPLAY_FACTOR = 2;
 
 export async function mountScene({ sceneId = null, spec = null, derivation = null }) {
   const view = new SceneView(sceneId);
@@ -38,6 +42,7 @@ class SceneView {
     this.runs = 0;
     this.result = null; // the server's run: what the panel, the plots and the FBD show
     this.resultB = null;
+    this.shownB = null;
     this.shown = null; // what canvas A draws: the server's run or the live preview
     this.live = null;
     this.changes = 0; // every change of a value, so a server run can tell it is behind
@@ -56,7 +61,11 @@ class SceneView {
       derived = derivation || postJSON("/api/v1/derive", this.target());
       derived.catch?.(() => {}); // shown by derive(); not an unhandled rejection meanwhile
       LiveModel.load(this.sceneId)
-        .then((live) => { this.live = live; this.preview(); })
+        .then((live) => { // a preview only while the server's run is not there yet
+          this.live = live;
+          $("canvas").dataset.live = "ready";
+          if (!this.result) this.preview();
+        })
         .catch((err) => { $("canvas").dataset.live = `unavailable: ${err.message}`; });
     }
     const specP = this.sceneId ? getJSON(`/api/v1/scenes/${this.sceneId}`) : null;
@@ -103,16 +112,21 @@ class SceneView {
     if (spec.coordinates.includes(this.phase)) $("phase-q").value = this.phase;
     this.result = null;
     this.resultB = null;
+    this.shownB = null;
     this.shown = null;
-    if (!this.sceneId) { // a spec of one's own: its equations printed for it, if they can be
-      this.live = null;
-      const asked = spec;
-      LiveModel.forSpec(spec)
-        .then((live) => { if (this.spec === asked) { this.live = live; this.preview(); } })
-        .catch((err) => { $("canvas").dataset.live = `unavailable: ${err.message}`; });
-    }
+    if (!this.sceneId) this.live = null;
     this.preview();
     await Promise.all([this.derive(derivation), this.run(), this.equilibria()]);
+    if (!this.sceneId && this.spec === spec) {
+      // A spec of one's own: its equations printed for it, once its other jobs are done (the
+      // pool runs one job per client at a time; its worker has the spec compiled by now).
+      try {
+        const live = await LiveModel.forSpec(spec);
+        if (this.spec === spec) { this.live = live; $("canvas").dataset.live = "ready"; }
+      } catch (err) {
+        $("canvas").dataset.live = `unavailable: ${err.message}`;
+      }
+    }
   }
 
   // ------------------------------------------------------------------ controls and URL state
@@ -187,7 +201,7 @@ class SceneView {
   // ------------------------------------------------------------------ simulation
   request(method, extra = {}) {
     const s = this.settings;
-    const body = { ...this.target(), parameters: this.params, initial: this.initial, t_end: s.t_end, fps: 60, method, ...extra };
+    const body = { ...this.target(), parameters: this.params, initial: this.initial, t_end: s.t_end, fps: SERVER_FPS, method, ...extra };
     if (isFixed(method)) body.dt = Number(s.dt);
     else { body.rtol = Number(s.tol); body.atol = Number(s.tol); }
     return body;
@@ -210,8 +224,9 @@ class SceneView {
       delete $("canvas").dataset.error;
       // A value moved since this run was asked for: the preview on the canvas is newer; the
       // panel and the plots take the server's run, the canvas waits for the next one.
-      if (changes === this.changes || !this.live) this.#show(a, "server");
-      if (b) this.stageB.setResult(this.spec, b, this.params);
+      if (changes === this.changes || !this.live) this.#show(forDisplay(a, DISPLAY_FACTOR), "server");
+      this.shownB = b ? forDisplay(b, DISPLAY_FACTOR) : null;
+      if (b) this.stageB.setResult(this.spec, this.shownB, this.params);
       showStats(b ? [a, b] : [a]);
       $("caption-a").textContent = b ? `A: ${a.stats.method}` : "";
       $("caption-b").textContent = b ? `B: ${b.stats.method}` : "";
@@ -227,7 +242,7 @@ class SceneView {
       if (id !== this.runs) return;
       showWarnings([`The simulation failed: ${err.message}`]);
       $("canvas").dataset.error = err.message;
-      if (this.shown && this.shown !== this.result) { // never leave a preview of a refused state
+      if (this.shown && this.shown.stats.preview) { // never leave a preview of a refused state
         this.shown = null;
         this.#waiting("No motion: the server refused this state (see the warnings).");
         this.#label(null);
@@ -296,7 +311,8 @@ class SceneView {
       b.dataset.kind = "server";
       const s = this.settings;
       const how = isFixed(st.method) ? `dt = ${s.dt} s` : `rtol = atol = ${s.tol}`;
-      b.textContent = `server run (${st.method}, ${how})`;
+      const drawn = st.display_factor > 1 ? `; ${SERVER_FPS} samples/s, drawn at ${SERVER_FPS * st.display_factor} by interpolation` : "";
+      b.textContent = `server run (${st.method}, ${how}${drawn})`;
       Object.assign(b.style, { background: "transparent", color: "inherit", borderColor: "transparent" });
     }
   }
@@ -386,7 +402,7 @@ class SceneView {
         } else if (this.time > end) this.time = end > 0 ? this.time % end : 0;
         this.stageA.draw(this.frameIndex());
         this.drag.overlay();
-        if (this.resultB) this.stageB.draw(this.frameIndex(this.resultB));
+        if (this.shownB) this.stageB.draw(this.frameIndex(this.shownB));
         $("clock").textContent = `t = ${this.time.toFixed(2)} s`;
         if (this.playing) $("scrub").value = end > 0 ? Math.round((1000 * this.time) / end) : 0;
         if (this.playing) this.fbd();
@@ -407,9 +423,9 @@ class SceneView {
     if (!now && t - (this.fbdAt || 0) < 150) return;
     this.fbdAt = t;
     if (!this.result || !$("fbd-svg")) return;
-    if (this.shown !== this.result) return; // the diagram is of the server's run, not a preview
+    if (!this.shown || this.shown.stats.preview) return; // of the server's run, not a preview
     const placed = this.derivation?.steps?.find((s) => s.id === "fbd")?.data;
-    const kinds = drawFBD($("fbd-svg"), this.spec, this.result, this.params, this.frameIndex(),
+    const kinds = drawFBD($("fbd-svg"), this.spec, this.result, this.params, this.frameIndex(this.result),
       { yaw: this.stageA.yaw, pitch: this.stageA.pitch }, placed);
     fbdLegend($("fbd-legend"), kinds);
   }
