@@ -17,8 +17,10 @@ function fmt(x) {
 function label(key) {
   const [kind, rest] = key.split(":");
   const name = rest.split("@")[0];
-  return { weight: `weight of ${name}`, spring: `spring ${name}`, potential: `potential ${name}`,
-    damper: `damper ${name}`, force: `force ${name}`, torque: `torque ${name}` }[kind] || key;
+  if (kind === "weight") return `weight of ${name}`;
+  if (!["spring", "potential", "damper", "force", "torque"].includes(kind)) return key;
+  // a spring named "spring" (or "spring 1") is not "spring spring": its name says its kind
+  return name.toLowerCase().startsWith(kind) ? name : `${kind} ${name}`;
 }
 
 function index(t, time) {
