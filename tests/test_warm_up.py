@@ -23,6 +23,7 @@ def test_warm_up_derives_and_compiles_every_scene_once(pool, monkeypatch):
     scenes = ["simple_pendulum", "spring_mass_damper"]
     monkeypatch.setattr(derivations, "scene_ids", lambda: scenes)
     derivation_of_scene.cache_clear()
+    compiled_scene.cache_clear()  # earlier tests may have compiled them in this process
     derivations.warm_up(pool, threading.Event())
     assert derivations.warm_state["done"] == derivations.warm_state["of"] == 2
     assert derivations.warm_state["seconds"] is not None

@@ -25,7 +25,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app import derivations
 from app.routes.scenes import unknown_scene
-from app.routes.simulate import post_simulate
+from app.routes.simulate import simulation_answer
 from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
 from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
 from mechanics.export_share import ShareError, decode_state, encode_state
@@ -226,7 +226,7 @@ async def _trajectory(request: SimulateRequest, http: Request, format: str) -> R
         spec: dict[str, Any] = load_scene(request.scene_id)
     else:
         spec = request.scene.model_dump(mode="json", by_alias=True)
-    answer = await post_simulate(request, http)
+    answer = await simulation_answer(request, http, gzip_ok=False)
     run = orjson.loads(answer.body)
     units = spec.get("units") or {}
     stem = _file_stem(request)

@@ -44,6 +44,12 @@ async def post_simulate(request: SimulateRequest, http: Request) -> Response:
     a few runs at once, one per client, the others waiting without holding a thread); a posted
     one runs in the pool.
     """
+    return await simulation_answer(request, http, gzip_ok=True)
+
+
+async def simulation_answer(request: SimulateRequest, http: Request, *, gzip_ok: bool) -> Response:
+    """The answer of POST /simulate; ``gzip_ok``: a repeated built-in run may go out gzipped
+    (once compressed, app/memo.py). Another route that reads the body passes False."""
     from mechanics.simulate import SimulationRequest, simulate
 
     options = SimulationRequest(
@@ -65,7 +71,7 @@ async def post_simulate(request: SimulateRequest, http: Request) -> Response:
         misses = built_in_runs.misses
         body = await built_in_runs.get_or_compute(key, compute)
         shared = built_in_runs.misses == misses  # found (or waited for), not computed here
-        if shared and "gzip" in http.headers.get("accept-encoding", ""):
+        if gzip_ok and shared and "gzip" in http.headers.get("accept-encoding", ""):
             headers = {"content-encoding": "gzip", "vary": "Accept-Encoding"}
             gz = await run_in_threadpool(built_in_runs.gzipped, key, body)
             return Response(gz, media_type="application/json", headers=headers)
