@@ -198,6 +198,8 @@ const STYLE = `
 .pv-term.pv-into { background: rgba(26, 127, 55, .14); }
 .pv-term.pv-pinned { box-shadow: inset 3px 0 0 var(--accent, #1a63d6); }
 .pv-untraced { font-size: .82rem; }
+html.lecture .pv-panel, html.lecture .pv-panel :is(summary, caption, th, td, .pv-origin, .pv-untraced) {
+  font-size: 1rem; } /* legible from the back of the hall: 24 px like the rest of lecture mode */
 .math-line.pv-line { background: rgba(255, 214, 0, .18); box-shadow: inset 3px 0 0 rgba(214, 160, 0, .9); }
 @media (max-width: 640px) { .pv-panel { margin-left: 0; } .pv-table .pv-origin { font-size: .78rem; }
   .pv-table, .pv-table tbody, .pv-table tr { display: block; } .pv-table thead { display: none; }

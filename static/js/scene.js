@@ -73,8 +73,8 @@ class SceneView {
     this.settings = readSettings(query);
     this.phase = query.get("phase");
     mountIntegrator(this.settings, () => this.schedule());
-    this.stageA = new Stage($("canvas"));
-    this.stageB = new Stage($("canvas-b"));
+    this.stageA = new Stage($("canvas"), { instruments: true });
+    this.stageB = new Stage($("canvas-b"), { instruments: false });
     this.badge = liveBadge();
     this.#waiting("Computing the motion…");
     this.#syncPlay();
@@ -83,6 +83,9 @@ class SceneView {
       list: $("steps"), toggle: $("lecture-toggle"), counter: $("step-counter"),
       onToggle: () => { this.#saveURL(); this.#plot(); }, onPlay: () => this.togglePlay(),
     });
+    // a share link's lecture step (0: the first), revealed once the steps are there
+    const step = query.has("step") ? Number(query.get("step")) : NaN;
+    this.wantedSteps = Number.isInteger(step) && step >= 0 ? step + 1 : null;
     this.lecture.set(query.get("lecture") === "1");
     watchWorkInputs(() => this.#plot());
     $("phase-q").addEventListener("change", () => { this.phase = $("phase-q").value; this.#saveURL(); this.#plot(); });
@@ -181,6 +184,7 @@ class SceneView {
       lecture: this.lecture.on,
     }));
     if (this.phase && this.phase !== this.spec.coordinates[0]) q.set("phase", this.phase);
+    if (this.lecture.on) q.set("step", String(this.lecture.revealed - 1));
     if (!this.sceneId) {
       const from = new URLSearchParams(location.search).get("from");
       if (from) q.set("from", from);
@@ -443,6 +447,7 @@ class SceneView {
     }
     renderSteps(steps, this.derivation, { target: () => this.target(), coordinates: this.spec.coordinates });
     showWarningsBelow(this.derivation.warnings);
+    if (this.wantedSteps) [this.lecture.revealed, this.wantedSteps] = [this.wantedSteps, null];
     this.lecture.apply();
     if (this.result) this.fbd(true);
     // One step at a time with a frame between: typesetting the whole derivation at once holds the
@@ -459,6 +464,42 @@ class SceneView {
       await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
     }
     steps.dataset.typeset = "1";
+    if (this.derivation.provenance) { // where each term comes from: tables under each equation
+      const { traceTerms } = await import("./provenance.js");
+      await traceTerms(steps, this.derivation.provenance);
+    }
+    this.#mountExtras();
+  }
+
+  /** The panels that read the page's state when asked: work–precision and exports, once. */
+  #mountExtras() {
+    if (this.extras) return;
+    this.extras = true;
+    const main = document.querySelector("main");
+    const source = { sceneId: this.sceneId, spec: this.sceneId ? null : this.spec };
+    const state = () => ({
+      parameters: this.params, initial: this.initial, settings: this.settings,
+      lecture: this.lecture.on, lectureStep: this.lecture.on ? this.lecture.revealed - 1 : null,
+    });
+    // Work–precision runs a dozen integrations when asked: folded, and loaded on first opening
+    const fold = Object.assign(document.createElement("section"), { className: "panel", id: "precision-panel" });
+    fold.innerHTML = '<details class="fold"><summary><h2 id="h-precision-fold">Work–precision: '
+      + "what accuracy costs, for this scene</h2></summary></details>";
+    fold.setAttribute("aria-labelledby", "h-precision-fold");
+    main.append(fold);
+    const details = fold.firstElementChild;
+    details.addEventListener("toggle", () => {
+      if (!details.open || details.dataset.mounted) return;
+      details.dataset.mounted = "1";
+      import("./precision.js").then(({ mountPrecision }) => {
+        mountPrecision(details, { ...source, getState: state });
+        details.querySelector("#h-precision")?.remove(); // the fold's summary is its heading
+        const inner = details.querySelector("#precision");
+        inner?.classList.remove("panel");
+        inner?.setAttribute("aria-labelledby", "h-precision-fold");
+      });
+    });
+    import("./exports.js").then(({ mountExports }) => mountExports(main, { ...source, getState: state }));
   }
 
   async equilibria() {

@@ -38,7 +38,7 @@ def precision_server(tmp_path_factory):
         sys.executable,
         "-m",
         "uvicorn",
-        "test_precision:precision_app",
+        "test_precision_page:precision_app",
         "--factory",
         "--app-dir",
         str(Path(__file__).parent),
