@@ -169,6 +169,12 @@ def warm_up(pool: WorkerPool, stop: threading.Event) -> None:
         except Exception as exc:  # noqa: BLE001 — a failed warm-up is a slower first request
             log.warning("warming %s failed (%s): it will be derived on first use", scene_id, exc)
         warm_state["done"] += 1
+    try:
+        from app.routes.scenes import _catalog
+
+        _catalog()  # the catalog page's one answer: every scene's spec and first second
+    except Exception as exc:  # noqa: BLE001 — the catalog is then computed on first visit
+        log.warning("warming the catalog failed (%s)", exc)
     warm_state["seconds"] = round(time.perf_counter() - start, 2)
     log.info("%d built-in scenes ready in %.1f s", len(ids), warm_state["seconds"])
 

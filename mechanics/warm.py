@@ -15,15 +15,18 @@ import time
 
 from mechanics.derive import derivation_of_scene, derive_scene
 from mechanics.equilibria import equilibria
+from mechanics.jscode import scene_live_module
 from mechanics.numeric import compiled_scene
 
 
 def warm_in_process(scene_id: str) -> float:
-    """The scene's derivation (JSON, through the cache) and its compiled equations, as the
-    server's `/derive` and `/simulate` use them. Returns the seconds it took."""
+    """The scene's derivation (JSON, through the cache), its compiled equations and their
+    JavaScript, as the server's `/derive`, `/simulate` and `/live` use them. Returns the seconds
+    it took."""
     start = time.perf_counter()
     derive_scene(scene_id)
     compiled_scene(scene_id)
+    scene_live_module(scene_id)  # the page's live preview asks for it first of all
     return time.perf_counter() - start
 
 
