@@ -23,7 +23,39 @@ export async function mountEditor() {
   });
   $("load-template").addEventListener("click", () => load($("template").value));
   $("derive").addEventListener("click", derive);
+  const token = query.get("share");
+  if (token && (await openShared(token))) return;
   await load(start);
+}
+
+/** A share link of one's own spec (/s/{token} lands here with ?share=token): the spec in the
+ * editor, the page's state (values, integrator, lecture step) in the query the scene view reads,
+ * then derived and run as the sharer saw it. False (with the reason shown) if the link is bad. */
+async function openShared(token) {
+  let state;
+  try {
+    state = await getJSON(`/api/v1/export/share/${encodeURIComponent(token)}`);
+  } catch (err) {
+    showErrors([{ field: "share", message: `This share link cannot be opened: ${err.message}` }]);
+    return false;
+  }
+  if (!state.scene) return false;
+  const q = new URLSearchParams();
+  for (const [k, v] of Object.entries({ ...state.parameters, ...state.initial })) q.set(k, String(v));
+  q.set("method", state.method || "dop853_c");
+  if (state.dt != null) q.set("dt", String(state.dt));
+  if (state.rtol != null) q.set("tol", String(state.rtol));
+  if (state.t_end != null) q.set("t_end", String(state.t_end));
+  if (state.compare) q.set("compare", "1");
+  if (state.method_b) q.set("method_b", state.method_b);
+  if (state.lecture) q.set("lecture", "1");
+  if (state.lecture_step != null) q.set("step", String(state.lecture_step));
+  if (state.phase) q.set("phase", state.phase);
+  history.replaceState(null, "", `${location.pathname}?${q}`);
+  $("spec").value = JSON.stringify(state.scene, null, 2);
+  numberLines();
+  await derive();
+  return true;
 }
 
 async function load(id) {

@@ -1,6 +1,6 @@
 """A share link opened in the browser: /s/{token} lands on the scene's page with the shared
-sliders, method, time span and lecture mode in place, values exact. (The lecture step travels as
-``step`` in the page's query; restoring it is the page's part.)"""
+sliders, method, time span, lecture mode and lecture step in place, values exact; a posted spec's
+link opens the editor with that spec, derived and run in the shared state."""
 
 from __future__ import annotations
 
@@ -48,4 +48,29 @@ def test_a_shared_link_restores_the_page_state(server, page):
     assert p.input_value("#method") == "rk4"
     assert float(p.input_value("#t_end")) == 7
     assert p.evaluate("document.body.classList.contains('lecture')")
+    # lecture_step 2 is the third step: three revealed, the third the current one
+    p.wait_for_selector("#steps[data-typeset='1']", timeout=60_000)
+    assert p.get_attribute("#steps", "data-revealed") == "3"
+    assert page.errors == []
+
+
+def test_a_shared_link_of_ones_own_spec_opens_it_in_the_editor(server, page):
+    spec = {
+        "title": "My swing",
+        "coordinates": ["phi"],
+        "parameters": {"m": 2.0, "L": 0.7, "g": 9.81},
+        "initial": {"phi": 0.4},
+        "bodies": [{"name": "seat", "mass": "m", "position": ["L*sin(phi)", "-L*cos(phi)", 0]}],
+        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    }
+    link = share(server, {"scene": spec, "parameters": {"L": 0.9}, "initial": {"phi": 0.25}})
+    p = page.page
+    p.goto(f"{server}{link['url']}")
+    p.wait_for_selector("#n-L", timeout=60_000)
+    page.settle(60_000)
+    assert urlparse(p.url).path == "/editor"
+    assert json.loads(p.input_value("#spec")) == spec
+    assert float(p.input_value("#n-L")) == 0.9
+    assert float(p.input_value("#n-phi")) == 0.25
+    assert p.text_content("#scene-title") == "My swing"
     assert page.errors == []
