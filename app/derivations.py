@@ -141,6 +141,20 @@ WARM_CLIENT = "warm-up"
 warm_state: dict[str, Any] = {"done": 0, "of": 0, "seconds": None}
 
 
+def _one_key_per_worker(scene_id: str, size: int) -> list[str]:
+    """Affinity keys that the pool sends to each of its ``size`` workers (it hashes them with
+    crc32, mechanics/pool.py), the scene's own first."""
+    import zlib
+
+    keys: dict[int, str] = {zlib.crc32(scene_id.encode()) % size: scene_id}
+    k = 0
+    while len(keys) < size and k < 1000:
+        key = f"{scene_id}#{k}"
+        keys.setdefault(zlib.crc32(key.encode()) % size, key)
+        k += 1
+    return list(keys.values())
+
+
 def warm_up(pool: WorkerPool, stop: threading.Event) -> None:
     """Every built-in scene derived, compiled and its equilibria found, before students ask:
     in this process (its simulations run here) and in the pool worker each scene's analysis
@@ -157,15 +171,18 @@ def warm_up(pool: WorkerPool, stop: threading.Event) -> None:
             return
         try:
             warm_in_process(scene_id)
-            pool.run(
-                warm_in_worker,
-                scene_id,
-                seconds=max(60.0, derive_seconds()),
-                client=WARM_CLIENT,
-                affinity=scene_id,
-                what=f"warming {scene_id}",
-                advice="it will be derived on first use",
-            )
+            # in every worker: a scene's requests go to its own worker when it is free, to
+            # another when it is busy (a class asks for the same scene at once)
+            for affinity in _one_key_per_worker(scene_id, pool.size):
+                pool.run(
+                    warm_in_worker,
+                    scene_id,
+                    seconds=max(60.0, derive_seconds()),
+                    client=WARM_CLIENT,
+                    affinity=affinity,
+                    what=f"warming {scene_id}",
+                    advice="it will be derived on first use",
+                )
         except Exception as exc:  # noqa: BLE001 — a failed warm-up is a slower first request
             log.warning("warming %s failed (%s): it will be derived on first use", scene_id, exc)
         warm_state["done"] += 1
