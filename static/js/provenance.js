@@ -119,6 +119,49 @@ function table(eq, origins, q, side) {
   return el("div", { className: "pv-scroll" }, t);
 }
 
+/** M and f entry by entry: each entry is the sum of the equation-of-motion terms it lists (by
+ * id: hovering an entry lights them, hovering one of them lights the entries it is part of). */
+function matrixTables(provenance) {
+  const byId = new Map();
+  for (const eom of Object.values(provenance.eom || {})) {
+    for (const side of [eom.lhs, eom.rhs]) for (const t of side?.terms || []) byId.set(t.id, t);
+  }
+  const names = Object.keys(provenance.eom || {});
+  const sum = (ids, sign = 1) => ids.map((id, k) => {
+    const tex = byId.get(id)?.latex ?? "?";
+    return (sign < 0 ? "- " : k ? "+ " : "") + (sign < 0 ? `\left(${tex}\right)` : tex);
+  }).join(" ");
+  const entry = (label, ids, terms) => {
+    const body = el("tbody", { className: "pv-term", tabIndex: 0 });
+    body.dataset.term = `matrix:${label}`;
+    body.dataset.via = ids.join(" ");
+    body.title = "the equation-of-motion terms this entry is made of: click to keep them lit";
+    body.append(el("tr", {},
+      el("td", { className: "pv-term-math", textContent: math(label) }),
+      el("td", { textContent: terms ? math(terms) : "0" })));
+    return body;
+  };
+  const head = (what) => el("thead", {}, el("tr", {},
+    el("th", { scope: "col", textContent: "entry" }), el("th", { scope: "col", textContent: what })));
+  const M = el("table", { className: "pv-table" }, head("the terms of the equation of motion it collects"));
+  const f = el("table", { className: "pv-table" }, head("right side minus the left side's terms free of q̈"));
+  (provenance.matrix?.M || []).forEach((row, j) => {
+    if (!row) return;
+    row.forEach((ids, k) => {
+      if (ids.length) {
+        const qk = dottedTex(names[k], 2);
+        M.append(entry(`M_{${j + 1}${k + 1}}\,${qk}`, ids, sum(ids)));
+      }
+    });
+  });
+  (provenance.matrix?.f || []).forEach((parts, j) => {
+    if (!parts) return;
+    const tex = [sum(parts.plus), sum(parts.minus, -1)].filter(Boolean).join(" ");
+    f.append(entry(`f_{${j + 1}}`, [...parts.plus, ...parts.minus], tex));
+  });
+  return [el("div", { className: "pv-scroll" }, M), el("div", { className: "pv-scroll" }, f)];
+}
+
 function panel(title, parts) {
   const box = el("details", { className: "pv-panel" });
   box.append(el("summary", { textContent: `Where each term of ${title} comes from` }), ...parts);
@@ -242,6 +285,11 @@ export async function traceTerms(container, provenance) {
       table(eom.lhs, origins, q, `left side ${math(`\\frac{d}{dt}\\frac{\\partial L}{\\partial ${d}} - \\frac{\\partial L}{\\partial ${n}}`)}`),
       table(eom.rhs, origins, q, `right side ${math(`Q_{${n}}`)} (non-conservative forces)`),
     ]);
+  }
+  if (provenance.matrix) {
+    const [M, f] = matrixTables(provenance);
+    place("matrix", "M", math("\\mathbf{M}"), [M]);
+    place("matrix", "f", math("\\mathbf{f}"), [f]);
   }
   wire(container);
   await typeset(added);

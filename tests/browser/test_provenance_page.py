@@ -28,8 +28,19 @@ def test_trace_terms_tables_and_hover(server, page, artifacts):
         }""",
         prov,
     )
-    # T and V, Q_r and Q_θ, the EoM of r and of θ: one panel under each line.
-    assert added == 6
+    # T and V, Q_r and Q_θ, the EoM of r and of θ, M and f: one panel under each line.
+    assert added == 8
+    # M_22 θ̈ collects the θ equation's θ̈ term m r² θ̈: hovering the entry lights that term
+    [inertia] = [
+        t for t in prov["eom"]["theta"]["lhs"]["terms"] if t["plain"] == "m*r**2*theta_ddot"
+    ]
+    entry = p.locator("li[data-step=matrix] tbody.pv-term").filter(has_text="M")
+    m22 = p.locator(f"li[data-step=matrix] tbody.pv-term[data-via='{inertia['id']}']")
+    assert m22.count() == 1 and entry.count() >= 2
+    m22.scroll_into_view_if_needed()
+    m22.hover()
+    term = p.locator(f"li[data-step=lagrange] tbody[data-term='{inertia['id']}']")
+    assert "pv-from" in term.get_attribute("class")
     assert p.locator("li[data-step=energy] .pv-panel").count() == 2
     assert p.locator("li[data-step=lagrange] .pv-panel").count() == 2
     assert p.locator(".pv-panel mjx-container").count() > 10  # typeset, not LaTeX source
