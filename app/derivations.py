@@ -56,6 +56,8 @@ POOL_WORKERS_ENV = "LAGRANGE_LAB_POOL_WORKERS"
 POOL_PER_CLIENT_ENV = "LAGRANGE_LAB_POOL_PER_CLIENT"
 TRUST_FORWARDED_ENV = "LAGRANGE_LAB_TRUST_FORWARDED"
 WARM_ENV = "LAGRANGE_LAB_WARM"
+#: Threads for blocking work per server process (anyio's default is 40).
+THREADS = 256
 
 SIMPLIFY_SCENE = (
     "simplify the scene (fewer coordinates or bodies, simpler expressions) and try again"
@@ -126,6 +128,13 @@ async def pool_lifespan(app: Any) -> AsyncIterator[None]:
     closed, its workers reaped, when the server stops. Unless ``LAGRANGE_LAB_WARM=0``, every
     built-in scene is then made ready in the background (`warm_up`)."""
     pool = start_pool()
+    # Routes that wait on the pool (equilibria, check, newton, a posted spec's jobs) hold a thread
+    # while they wait, and static files are read in threads too: with anyio's default of 40, a
+    # class's waiting requests would hold every thread and a page's files would queue behind
+    # them. Waiting threads cost little; the pool and the gates bound the work itself.
+    import anyio.to_thread
+
+    anyio.to_thread.current_default_thread_limiter().total_tokens = THREADS
     stop = threading.Event()
     if os.environ.get(WARM_ENV, "1").strip() != "0":
         threading.Thread(target=warm_up, args=(pool, stop), name="warm-up", daemon=True).start()

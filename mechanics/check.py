@@ -10,6 +10,7 @@ parameters swapped, q mixed up with q̇) and the units of every term are checked
 
 from __future__ import annotations
 
+import cmath
 import math
 import random
 from dataclasses import dataclass, field
@@ -177,9 +178,12 @@ class _Judge:
         out = []
         for s in self.motion_states if motion_only else self.states:
             try:
-                out.append(complex(expr.xreplace(s).evalf(25)))
-            except (TypeError, ValueError):
-                out.append(complex("nan"))
+                v = complex(expr.xreplace(s).evalf(25))
+                abs(v)  # a modulus past double precision (1e308 + 1e308 i) raises here
+            except (TypeError, ValueError, ArithmeticError, MemoryError):  # too many digits
+                v = complex("nan")
+            finite = math.isfinite(v.real) and math.isfinite(v.imag)
+            out.append(v if finite else complex("nan"))  # beyond doubles: no number to compare
         return out
 
     def same(self, a: sp.Expr, b: sp.Expr) -> bool:
@@ -191,6 +195,13 @@ class _Judge:
     def run(self, verdict: Verdict) -> None:
         q = self.quantity
         fb = verdict.feedback
+        if all(cmath.isnan(v) for v in self.values(self.given)):
+            fb.append(
+                "Your answer has no value at any state sampled: it divides by something that "
+                "is zero, or its numbers are beyond double precision. Check the denominators "
+                "and the powers."
+            )
+            return
         if q == "eom":
             self._eom(verdict)
             return
@@ -220,7 +231,9 @@ class _Judge:
         """a/b when it is the same number at every state (of the motion only, if asked)."""
         va, vb = self.values(a, motion_only), self.values(b, motion_only)
         ratios = [x / y for x, y in zip(va, vb, strict=True) if abs(y) > 1e-12]
-        if not ratios or any(abs(r - ratios[0]) > 1e-8 * max(1, abs(ratios[0])) for r in ratios):
+        if len(ratios) < len(va) // 2 or not all(cmath.isfinite(r) for r in ratios):
+            return None  # no number at most states (overflow, 0/0): no factor to speak of
+        if any(abs(r - ratios[0]) > 1e-8 * max(1, abs(ratios[0])) for r in ratios):
             return None
         return sp.nsimplify(round(ratios[0].real, 10), rational=True)
 
@@ -329,6 +342,11 @@ class _Judge:
         g, e = self._canonical(given), self._canonical(expected)
         if len(g) + len(e) > MAX_TERMS:
             return []
+        if any(c.has(sp.zoo, sp.nan, sp.oo, -sp.oo) for c in g.values()):
+            return [
+                "Your answer divides by zero: one of its denominators is identically zero "
+                "(sin²θ + cos²θ − 1, say), so it has no value at all."
+            ]
         fb = []
         for mono, coeff in e.items():
             term = coeff * mono
@@ -400,6 +418,8 @@ class _Judge:
     def _fixed_ratio(a: list[complex], b: list[complex]) -> sp.Expr | None:
         """a/b when it is one number at every sampled state (parameters varied too)."""
         ratios = [x / y for x, y in zip(a, b, strict=True) if abs(y) > 1e-12]
+        if not all(cmath.isfinite(r) for r in ratios):
+            return None
         if len(ratios) < len(a) // 2 or any(
             abs(r - ratios[0]) > 1e-8 * max(1, abs(ratios[0])) for r in ratios
         ):

@@ -131,7 +131,7 @@ def trajectory_csv(
     out = io.StringIO()
     for line in comments:
         out.write("# " + line.replace("\n", " ").replace("\r", " ") + "\n")
-    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in columns) + "\n")
+    out.write(",".join(_header_cell(name, unit) for name, unit in columns) + "\n")
     series = [_series(run, name) for name, _ in columns]
     for row in zip(*series, strict=True):
         out.write(",".join("nan" if v is None else repr(float(v)) for v in row) + "\n")
@@ -147,3 +147,11 @@ def stats_lines(stats: Mapping[str, Any], prefix: str = "stats.") -> list[str]:
         else:
             lines.append(f"{prefix}{key}: {value}")
     return lines
+
+
+def _header_cell(name: str, unit: str) -> str:
+    """``name [unit]`` as one CSV cell whatever the unit says: a spec's unit is someone's text,
+    and a line break, a comma, a quote or a '#' in it would add rows, split columns or hide the
+    rest of the header from a reader that skips '#' comments. Those characters are replaced."""
+    cell = f"{name} [{unit}]" if unit else name
+    return "".join(" " if ch in '\r\n\t,"#' or ord(ch) < 32 else ch for ch in cell)

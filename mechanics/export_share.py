@@ -74,7 +74,7 @@ def decode_state(token: str) -> dict[str, Any]:
         raise ShareError("not a share token: its compressed data is cut short")
     try:
         state = json.loads(data.decode("utf-8"), parse_constant=_no_constant)
-    except (UnicodeDecodeError, ValueError) as exc:
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:  # [[[[…: nesting too deep
         raise ShareError(f"the token's state is not valid JSON ({exc})") from None
     if not isinstance(state, dict):
         raise ShareError("the token's state is not a JSON object")

@@ -219,7 +219,7 @@ def _grid(t_end: float, dt: float | None) -> tuple[np.ndarray, float | None]:
     if dt is None:
         return np.linspace(0.0, t_end, SAMPLES), None
     intervals = max(1, min(SAMPLES - 1, math.ceil(t_end / dt - 1e-9)))
-    per = math.ceil(t_end / intervals / dt - 1e-9)
+    per = max(1, math.ceil(t_end / intervals / dt - 1e-9))  # a step past t_end: one step
     return np.linspace(0.0, t_end, intervals + 1), t_end / (intervals * per)
 
 

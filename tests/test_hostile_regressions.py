@@ -211,3 +211,64 @@ def test_a_huge_power_answer_is_judged_without_expanding_it():
     verdict = check(derivation_of("elastic_pendulum", None), "T", "(theta + theta_dot + m + 1)**30")
     assert verdict.correct is False
     assert any("mixes units" in line for line in verdict.feedback)
+
+
+# --- found by a hostile play-test of the new endpoints --------------------------------------
+
+
+def test_answers_beyond_double_precision_are_judged_not_crashed():
+    """exp(exp(exp(exp(θ)))) overflowed abs() in the check (a 500); 1/(sin²+cos²−1) was
+    'off by a factor of ∞'. Neither may crash, and no factor ∞ or NaN may be claimed."""
+    from mechanics.check import check
+    from mechanics.jobs import derivation_of
+
+    d = derivation_of("simple_pendulum", None)
+    for quantity, answer in [
+        ("V", "exp(exp(exp(exp(theta))))"),
+        ("T", "exp(exp(exp(exp(theta))))"),
+        ("V", "((sin(theta)+cos(theta))**64)**64"),
+        ("T", "theta_dot**2/(sin(theta)**2+cos(theta)**2-1)"),
+    ]:
+        verdict = check(d, quantity, answer)
+        assert verdict.correct is False
+        text = " ".join(verdict.feedback)
+        assert "infty" not in text and "NaN" not in text, (answer, text)
+    divided = check(d, "T", "theta_dot**2/(sin(theta)**2+cos(theta)**2-1)")
+    assert any("divides by zero" in line for line in divided.feedback)
+
+
+def test_a_step_longer_than_the_run_is_one_step_not_a_crash():
+    """steps = [1e10] with t_end = 10 divided by zero in the precision grid (a 500)."""
+    from mechanics.precision import _grid
+
+    times, dt = _grid(10.0, 1e10)
+    assert times[0] == 0.0 and times[-1] == 10.0 and dt == 10.0
+
+
+def test_a_share_token_nested_too_deep_is_refused_naming_it():
+    import base64
+    import zlib
+
+    from mechanics.export_share import ShareError, decode_state
+
+    token = "z" + base64.urlsafe_b64encode(zlib.compress(b"[" * 250_000, 9)).decode().rstrip("=")
+    with pytest.raises(ShareError):
+        decode_state(token)
+
+
+def test_units_cannot_add_rows_or_columns_to_the_csv_header():
+    import csv
+    import io
+
+    from mechanics.export_formats import trajectory_csv
+
+    run = {"t": [0.0, 0.1], "q": {"theta": [1.0, 1.1]}, "q_dot": {"theta": [0.0, 0.2]}}
+    units = {"theta": 'rad]\n=1+1,6,"6"\n#['}
+    text = trajectory_csv(run, units)
+    rows = list(csv.reader(io.StringIO(text)))
+    header = rows[0]
+    # one header row of t, θ, θ̇ (energies absent here), then the two samples: nothing added
+    assert len(rows) == 3 and all(len(r) == len(header) == 3 for r in rows)
+    assert [h.split(" ")[0] for h in header] == ["t", "theta", "theta_dot"]
+    assert not any(ch in cell for cell in header for ch in '\n#"')
+    assert not text.splitlines()[0].startswith("#")
