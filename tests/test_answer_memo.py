@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+from concurrent.futures import ThreadPoolExecutor
 
 import orjson
 import pytest
@@ -11,6 +12,13 @@ from fastapi.testclient import TestClient
 from app.main import app
 from app.memo import AnswerMemo
 from app.routes import simulate as simulate_route
+
+
+def run_async(coroutine_function):
+    """asyncio.run in a thread of its own: the browser tests' Playwright (sync API) keeps an
+    event loop running in the main thread for the whole session."""
+    with ThreadPoolExecutor(1) as pool:
+        return pool.submit(asyncio.run, coroutine_function()).result()
 
 
 def test_concurrent_identical_requests_share_one_computation():
@@ -28,7 +36,7 @@ def test_concurrent_identical_requests_share_one_computation():
         again = await memo.get_or_compute("k", compute)
         return bodies, again
 
-    bodies, again = asyncio.run(crowd())
+    bodies, again = run_async(crowd)
     assert bodies == [b"answer"] * 20 and again == b"answer"
     assert calls == 1
 
@@ -53,7 +61,7 @@ def test_an_answer_not_to_keep_and_a_failure_are_each_waiters_own():
             await memo.get_or_compute("f", failing)
         return first, memo.get("k"), memo.get("f")
 
-    first, kept, failed = asyncio.run(run())
+    first, kept, failed = run_async(run)
     assert calls == 3  # nobody was handed another request's cut-short run
     assert sorted(first) == [b"cut short 1", b"cut short 2", b"cut short 3"]
     assert kept is None and failed is None

@@ -487,6 +487,7 @@ def own_equilibrium(sid: str, guess) -> np.ndarray:
         for sid, q0, closed, why in EQUILIBRIA
     ],
 )
+@pytest.mark.timeout(600)  # sympy's solve takes ~20 s of CPU for the rod on a turntable
 def test_equilibrium_stability_and_frequencies(sid, q0, closed):
     p = SYSTEMS[sid].parameters
     q0 = own_equilibrium(sid, q0 if q0 is not None else [0.3])
