@@ -427,17 +427,18 @@ def _summary(
     if abs(change) >= 1e-3:
         verb = "creates" if change > 0 else "destroys"
         parts.append(
-            f"measured with the true energy, your model {verb} {abs(change):.0%} of the motion's "
-            f"energy in {energy['energy_until']:.2f} s"
+            f"measured with the true energy, your model {verb} energy: {abs(change):.0%} of the "
+            f"true motion's largest kinetic energy ({energy['energy_scale']:.3g}) "
+            f"in {energy['energy_until']:.2f} s"
             + (f" (up to {most:.0%} along the way)" if most > 1.5 * abs(change) else "")
         )
     elif most >= 1e-3:
         parts.append(
             f"measured with the true energy, your model's energy swings by up to {most:.0%} "
-            "of the motion's energy"
+            f"of the true motion's largest kinetic energy ({energy['energy_scale']:.3g})"
         )
     if not parts:
         return "Your answer predicts the same motion as the derivation."
     text = "; ".join(parts)
     text = text[0].upper() + text[1:]
-    return f"{text}: {blamed[0].lower() + blamed[1:]}" if blamed else f"{text}."
+    return f"{text}. The cause: {blamed[0].lower() + blamed[1:]}" if blamed else f"{text}."

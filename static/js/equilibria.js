@@ -68,7 +68,8 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       tag.classList.add(e.stable ? "stable" : "unstable");
       tag.textContent = kind;
       tag.title = KIND_WORDS[kind] || "";
-      if (e.reason) li.querySelector(".why").textContent = `${KIND_WORDS[kind] || kind}: ${e.reason}.`;
+      // the reason says why in full; the kind's own gloss would say half of it twice
+      if (e.reason) li.querySelector(".why").textContent = `${kind[0].toUpperCase()}${kind.slice(1)}: ${e.reason}.`;
       if (spec) {
         const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
         svg.setAttribute("class", "eq-sketch");
