@@ -332,10 +332,10 @@ def stop_server(server: subprocess.Popen) -> None:
             continue
 
 
-def tree_rss_mib(root: int) -> tuple[float, int]:
-    """Resident memory of a process and all its descendants (MiB), and how many they are."""
+def _tree_stats(root: int) -> list[list[str]]:
+    """/proc/<pid>/stat fields (after the command name) of a process and all its descendants."""
     children: dict[int, list[int]] = defaultdict(list)
-    rss: dict[int, int] = {}
+    stats: dict[int, list[str]] = {}
     for entry in Path("/proc").iterdir():
         if not entry.name.isdigit():
             continue
@@ -343,39 +343,27 @@ def tree_rss_mib(root: int) -> tuple[float, int]:
             stat = (entry / "stat").read_text()
             fields = stat[stat.rindex(")") + 2 :].split()
             children[int(fields[1])].append(int(entry.name))
-            rss[int(entry.name)] = int(fields[21]) * os.sysconf("SC_PAGE_SIZE")
+            stats[int(entry.name)] = fields
         except (OSError, ValueError, IndexError):
             continue
-    todo, total, count = [root], 0, 0
+    todo, out = [root], []
     while todo:
         pid = todo.pop()
-        total += rss.get(pid, 0)
-        count += pid in rss
+        if pid in stats:
+            out.append(stats[pid])
         todo += children.get(pid, [])
-    return total / 2**20, count
+    return out
+
+
+def tree_rss_mib(root: int) -> tuple[float, int]:
+    """Resident memory of a process and all its descendants (MiB), and how many they are."""
+    tree = _tree_stats(root)
+    return sum(int(f[21]) for f in tree) * os.sysconf("SC_PAGE_SIZE") / 2**20, len(tree)
 
 
 def tree_cpu_seconds(root: int) -> float:
     """CPU time (user + system, children reaped included) of a process and its descendants."""
-    children: dict[int, list[int]] = defaultdict(list)
-    cpu: dict[int, float] = {}
-    tick = os.sysconf("SC_CLK_TCK")
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            stat = (entry / "stat").read_text()
-            fields = stat[stat.rindex(")") + 2 :].split()
-            children[int(fields[1])].append(int(entry.name))
-            cpu[int(entry.name)] = sum(int(x) for x in fields[11:15]) / tick
-        except (OSError, ValueError, IndexError):
-            continue
-    todo, total = [root], 0.0
-    while todo:
-        pid = todo.pop()
-        total += cpu.get(pid, 0.0)
-        todo += children.get(pid, [])
-    return total
+    return sum(sum(int(x) for x in f[11:15]) for f in _tree_stats(root)) / os.sysconf("SC_CLK_TCK")
 
 
 async def watch_rss(root: int, stop: float, samples: list[float]) -> None:
