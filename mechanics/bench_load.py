@@ -58,6 +58,9 @@ class Tally:
     errors: dict[str, int] = field(default_factory=lambda: defaultdict(int))
     server_errors: dict[str, int] = field(default_factory=lambda: defaultdict(int))
     hostile: list[tuple[str, int | str, float]] = field(default_factory=list)
+    #: (endpoint, part) -> seconds, from the answers' Server-Timing headers: "app" is the server's
+    #: time from the request's arrival to its answer; a route may add its parts ("gate", "run").
+    server: dict[tuple[str, str], list[float]] = field(default_factory=lambda: defaultdict(list))
 
 
 class TimeUp(Exception):
@@ -84,10 +87,13 @@ class Student:
                 keep = label in ("page", "derive", "scene json", "asset js")
                 data = await r.aread() if keep else b"".join([c async for c in r.aiter_raw()])
                 status = r.status_code
+                timing = r.headers.get("server-timing", "")
         except httpx.HTTPError:
             self.tally.errors[label] += 1
             return b""
         self.tally.latencies[label].append(time.perf_counter() - t0)
+        for part, seconds in _server_timing(timing):
+            self.tally.server[label, part].append(seconds)
         if status >= 500:
             self.tally.server_errors[label] += 1
         if status >= 400:
@@ -161,6 +167,17 @@ class Student:
     async def check(self, scene_id: str, quantity: str, answer: str) -> None:
         body = {"scene_id": scene_id, "quantity": quantity, "answer": answer}
         await self.call("check", "POST", "/api/v1/check", body)
+
+
+def _server_timing(header: str) -> list[tuple[str, float]]:
+    """``app;dur=12.5, gate;dur=0.1`` -> [("app", 0.0125), ("gate", 0.0001)]."""
+    out = []
+    for entry in header.split(","):
+        name, _, rest = entry.strip().partition(";")
+        match = re.search(r"dur=([0-9.]+)", rest)
+        if name and match:
+            out.append((name, float(match.group(1)) / 1e3))
+    return out
 
 
 def _energies(derivation: dict) -> dict[str, str]:
@@ -457,6 +474,15 @@ def print_config(result: dict) -> dict[str, float]:
         f"{result['client_cpu']:.0f} s of CPU, the server {result['server_cpu']:.0f} s "
         f"({result['server_cpu'] / result['duration']:.2f} of {os.cpu_count()} cores over the run)"
     )
+    parts = sorted(t.server)
+    if parts:
+        print("where the time went, by the server's Server-Timing headers (ms):")
+        for label, part in parts:
+            ms = [x * 1e3 for x in t.server[label, part]]
+            print(
+                f"  {label:<18} {part:<8} n {len(ms):6d}  p50 {percentile(ms, 50):8.1f}  "
+                f"p95 {percentile(ms, 95):8.1f}  p99 {percentile(ms, 99):8.1f}"
+            )
     for kind, status, seconds in sorted(t.hostile, key=lambda h: h[0]):
         print(f"hostile {kind:<28} -> {status} in {seconds:5.1f} s")
     worst = max((p95.get(e, float("inf")) for e in TARGET_ENDPOINTS), default=float("inf"))

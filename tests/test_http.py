@@ -67,6 +67,24 @@ def test_a_simulate_answer_is_strict_json(client):
 # -- compression -----------------------------------------------------------------------------
 
 
+def test_answers_say_where_the_servers_time_went(client):
+    """Server-Timing: "app" on every answer (arrival to first byte); a simulation adds its wait
+    at the gate and its run, and a repeated one says it came from the memo."""
+
+    def parts(r) -> dict[str, float]:
+        return {
+            m[1]: float(m[2])
+            for m in re.finditer(r"(\w+);dur=([0-9.]+)", r.headers["server-timing"])
+        }
+
+    assert "app" in parts(client.get("/healthz"))
+    body = {"scene_id": "simple_pendulum", "t_end": 0.75, "parameters": {"l": 1.2345}}
+    first = parts(client.post("/api/v1/simulate", json=body))
+    assert {"app", "gate", "thread", "run"} <= set(first)
+    assert first["run"] <= first["thread"] <= first["app"] + 0.2  # each inside the other
+    assert "memo" in parts(client.post("/api/v1/simulate", json=body))
+
+
 @pytest.mark.parametrize("url", ["/", "/scenes/double_pendulum", "/api/v1/scenes", "/openapi.json"])
 def test_pages_and_json_are_gzipped(client, url):
     r = client.get(url, headers={"accept-encoding": "gzip"})

@@ -48,3 +48,23 @@ def test_warming_is_on_unless_switched_off(monkeypatch):
 
     assert Settings.from_env({}).warm is True
     assert Settings.from_env({"LAGRANGE_LAB_WARM": "0"}).warm is False
+
+
+def test_after_warming_the_pages_first_run_builds_nothing(monkeypatch):
+    """The page's run asks for constraint forces, which Newton's method and lambdify build on a
+    scene's first run (1.5 s of GIL-holding sympy for the double pendulum): a class's first runs
+    queued behind it, to a simulate p95 of 2.5 s under load. Warming builds them."""
+    import sympy as sp
+
+    from mechanics import warm
+    from mechanics.simulate import SimulationRequest, simulate
+
+    compiled_scene.cache_clear()
+    warm.warm_in_process("double_pendulum")
+    built = []
+    real = sp.lambdify
+    monkeypatch.setattr(sp, "lambdify", lambda *a, **k: built.append(a) or real(*a, **k))
+    page_run = SimulationRequest(t_end=10, fps=30, method="dop853_c", constraint_forces=True)
+    result = simulate("double_pendulum", None, page_run)
+    assert result["constraint_forces"]  # the run did ask for them
+    assert built == []

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+import time
 from functools import partial
 
 from fastapi import APIRouter, Request, Response
 from starlette.concurrency import run_in_threadpool
 
-from app.derivations import in_pool, in_process, posted_key
+from app.derivations import in_pool, in_process, posted_key, server_timing
 from app.memo import AnswerMemo
 from app.responses import ORJSONResponse, dumps
 from app.routes.scenes import unknown_scene
@@ -60,22 +61,29 @@ async def simulation_answer(request: SimulateRequest, http: Request, *, gzip_ok:
             raise unknown_scene(request.scene_id)
         run = partial(simulate, request.scene_id, None, options)
 
+        timing: dict[str, float] = {}
+
         def encoded() -> tuple[bytes, bool]:
+            t0 = time.perf_counter()
             result = run()
+            timing["run"] = time.perf_counter() - t0
             return dumps(result), _not_load_dependent(result)
 
         async def compute() -> tuple[bytes, bool]:
-            return await in_process(http, encoded, what="simulation")
+            return await in_process(http, encoded, what="simulation", timing=timing)
 
         key = dumps(request.model_dump(mode="json"), sort=True).decode()
         misses = built_in_runs.misses
         body = await built_in_runs.get_or_compute(key, compute)
         shared = built_in_runs.misses == misses  # found (or waited for), not computed here
+        times = {"memo": 0.0} if shared else timing
         if gzip_ok and shared and "gzip" in http.headers.get("accept-encoding", ""):
             headers = {"content-encoding": "gzip", "vary": "Accept-Encoding"}
             gz = await run_in_threadpool(built_in_runs.gzipped, key, body)
-            return Response(gz, media_type="application/json", headers=headers)
-        return Response(body, media_type="application/json")
+            return Response(
+                gz, media_type="application/json", headers=headers | server_timing(times)
+            )
+        return Response(body, media_type="application/json", headers=server_timing(times))
     from mechanics.jobs import simulation
 
     key = await run_in_threadpool(posted_key, request.scene)
