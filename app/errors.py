@@ -50,22 +50,29 @@ def unprocessable(errors: Iterable[dict[str, str]]) -> JSONResponse:
 async def http_error(request: Request, exc: HTTPException) -> JSONResponse:
     """An HTTPException (an unknown scene's 404, a route's 405) in the one shape. A detail
     that is already a list of {field, message} is kept; a sentence gets the field it is about:
-    ``scene_id`` for a 404 of a matched route (the only 404 a route raises), ``path`` for a
-    404/405 of the URL itself, ``scene`` for a 503, else ``body``."""
+    ``scene_id`` for a 404 of a matched route (the only 404 a route raises as a sentence; it
+    is told where the ids are listed), ``path`` for a 404/405 of the URL itself, ``scene`` for a
+    503, else ``body``. A 404 about anything else is raised as a list naming its field."""
     if isinstance(exc.detail, list):
         body: dict[str, Any] = {"detail": exc.detail}
     else:
         matched = request.scope.get("route") is not None
+        message = str(exc.detail)
         if exc.status_code == 404 and matched:
             field = "scene_id"
+            message += WHERE_SCENE_IDS
         elif exc.status_code in (404, 405):
             field = "path"
         elif exc.status_code == 503:
             field = "scene"  # the only work refused for load is a posted scene's
         else:
             field = "body"
-        body = error_body(field, str(exc.detail))
+        body = error_body(field, message)
     return JSONResponse(body, status_code=exc.status_code, headers=exc.headers)
+
+
+#: Said after an unknown scene_id, whichever route raised it (/derive, /check, live.js, …).
+WHERE_SCENE_IDS = " (GET /api/v1/scenes lists the scene ids)"
 
 
 #: What every /api/v1 operation may answer besides its own, documented on each in OpenAPI.

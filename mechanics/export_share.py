@@ -7,7 +7,10 @@ Decoding is strict because the token is someone else's input: its length is boun
 anything else, the decompressed size is bounded while decompressing (a zlib bomb stops at the
 limit), the JSON must be an object of finite numbers (``NaN``/``Infinity`` are refused), and the
 caller validates the object against its schema. Every failure is a `ShareError` naming what is
-wrong, which the web layer answers as a 422 on the field ``token``.
+wrong, which the web layer answers as a 422 on the field ``token``. A state that fits the schema
+must still fit its scene (`state_problems`): a built-in scene that exists, values and a phase
+coordinate the scene has, and no value named like a setting of the page's query string (a
+parameter ``t_end`` would write a second ``t_end`` into the link the page opens).
 
 Floats survive exactly: JSON writes them with ``repr``, the shortest text that reads back as the
 same double.
@@ -20,7 +23,10 @@ import binascii
 import json
 import re
 import zlib
+from collections.abc import Mapping
 from typing import Any
+
+from mechanics.scenes import load_scene, scene_ids
 
 #: The format of a token: the letter it starts with. A new format gets a new letter, and old
 #: links still decode.
@@ -33,6 +39,14 @@ MAX_TOKEN = 12_000
 MAX_JSON = 256 * 1024
 
 _TOKEN = re.compile(r"^[A-Za-z0-9_-]+$")
+
+#: Keys of a scene page's query string that are the page's own settings, not values of the
+#: scene (static/js/controls.js writeQuery and scene.js): a scene value under one of these names
+#: could not be told apart from the setting in a link.
+PAGE_SETTINGS = frozenset(
+    {"method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture"}
+    | {"phase", "step", "from", "fps", "share"}
+)
 
 
 class ShareError(ValueError):
@@ -83,3 +97,65 @@ def decode_state(token: str) -> dict[str, Any]:
 
 def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not a number JSON allows")
+
+
+def state_problems(state: Mapping[str, Any]) -> list[dict[str, str]]:
+    """What a schema-valid state names that its scene does not have, as {field, message}
+    (fields relative to the state: ``scene_id``, ``parameters.t_end``, ``phase``); empty when
+    the state fits its scene.
+
+    ``state`` is the state as JSON: ``scene_id`` (a built-in scene) or ``scene`` (a posted spec,
+    whose own names are checked), ``parameters`` and ``initial`` by name, ``phase``.
+    """
+    scene_id = state.get("scene_id")
+    if scene_id is not None:
+        if scene_id not in scene_ids():
+            return [
+                {
+                    "field": "scene_id",
+                    # the words of app/errors.py's 404 for an unknown scene_id
+                    "message": f"unknown scene '{scene_id}' (GET /api/v1/scenes lists the "
+                    "scene ids)",
+                }
+            ]
+        spec: Mapping[str, Any] = load_scene(scene_id)
+        whose = f"the scene '{scene_id}'"
+    else:
+        spec = state.get("scene") or {}
+        whose = "the posted scene"
+    parameters = set(spec.get("parameters") or {})
+    coordinates = list(spec.get("coordinates") or [])
+    values = set(coordinates) | {f"{q}_dot" for q in coordinates}
+    problems = []
+    for where, given, known, kind in (
+        ("parameters", state.get("parameters") or {}, parameters, "parameter"),
+        ("initial", state.get("initial") or {}, values, "coordinate or velocity"),
+    ):
+        for name in given:
+            if name in known and (scene_id is None or name not in PAGE_SETTINGS):
+                continue
+            if name in PAGE_SETTINGS:
+                message = f"'{name}' is a setting of the page, not a {kind} of {whose}"
+                if name in _STATE_KEYS:
+                    message += f": give it as the state's own '{name}'"
+            else:
+                message = f"{whose} has no {kind} '{name}'; it has {_listed(known)}"
+            problems.append({"field": f"{where}.{name}", "message": message})
+    phase = state.get("phase")
+    if phase is not None and phase not in coordinates:
+        problems.append(
+            {
+                "field": "phase",
+                "message": f"{whose} has no coordinate '{phase}'; it has {_listed(coordinates)}",
+            }
+        )
+    return problems
+
+
+#: The settings a state carries under the same name as the page's query key.
+_STATE_KEYS = frozenset({"method", "method_b", "dt", "t_end", "compare", "lecture", "phase"})
+
+
+def _listed(names: Any) -> str:
+    names = sorted(names)
+    return ", ".join(names) if names else "none"

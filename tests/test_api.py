@@ -78,7 +78,12 @@ def test_an_unknown_scene_is_404(client, scene_id):
     response = client.get(f"/api/v1/scenes/{scene_id}")
     assert response.status_code == 404
     assert response.json() == {
-        "detail": [{"field": "scene_id", "message": f"unknown scene '{scene_id}'"}]
+        "detail": [
+            {
+                "field": "scene_id",
+                "message": f"unknown scene '{scene_id}' (GET /api/v1/scenes lists the scene ids)",
+            }
+        ]
     }
 
 
@@ -90,7 +95,12 @@ def test_deriving_an_unknown_scene_is_404(client):
     response = client.post("/api/v1/derive", json={"scene_id": "no_such_scene"})
     assert response.status_code == 404
     assert response.json() == {
-        "detail": [{"field": "scene_id", "message": "unknown scene 'no_such_scene'"}]
+        "detail": [
+            {
+                "field": "scene_id",
+                "message": "unknown scene 'no_such_scene' (GET /api/v1/scenes lists the scene ids)",
+            }
+        ]
     }
 
 

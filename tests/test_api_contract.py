@@ -77,7 +77,10 @@ def test_an_unknown_scene_is_a_404_naming_scene_id(client):
         client.post("/api/v1/equilibria", json={"scene_id": "no_such_scene"}),
     ):
         problem = one_error(response, 404)
-        assert problem == {"field": "scene_id", "message": "unknown scene 'no_such_scene'"}
+        assert problem == {
+            "field": "scene_id",
+            "message": "unknown scene 'no_such_scene' (GET /api/v1/scenes lists the scene ids)",
+        }
 
 
 def test_a_path_that_names_no_route_is_a_404_naming_the_path(client):

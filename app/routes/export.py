@@ -28,7 +28,7 @@ from app.routes.scenes import unknown_scene
 from app.routes.simulate import simulation_answer
 from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
 from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
-from mechanics.export_share import ShareError, decode_state, encode_state
+from mechanics.export_share import ShareError, decode_state, encode_state, state_problems
 from mechanics.integrators import METHODS
 from mechanics.scenes import load_scene, scene_ids
 from mechanics.spec import IDENT, MAX_COORDINATES, MAX_PARAMETERS
@@ -377,6 +377,11 @@ def post_share(state: ShareState) -> ShareLink:
     parameters, initial state, method, tolerances or step, t_end and lecture step, with every
     number exact. Nothing is stored on the server, so it works on any server, forever."""
     document = state.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    problems = state_problems(document)
+    if any(p["field"] == "scene_id" for p in problems):
+        raise unknown_scene(document["scene_id"])  # the 404 of every other unknown scene_id
+    if problems:
+        raise HTTPException(422, problems)
     try:
         token = encode_state(document)
     except (ShareError, ValueError) as exc:
@@ -417,7 +422,7 @@ def open_share(token: str) -> RedirectResponse:
 def _decoded(token: str) -> ShareState:
     try:
         document = decode_state(token)
-        return ShareState.model_validate(document)
+        state = ShareState.model_validate(document)
     except ShareError as exc:
         raise HTTPException(422, [{"field": "token", "message": str(exc)}]) from None
     except ValidationError as exc:
@@ -429,6 +434,14 @@ def _decoded(token: str) -> ShareState:
             for e in exc.errors()
         ]
         raise HTTPException(422, problems) from None
+    # a hand-made token may name a scene or values the scene does not have: said here, not by
+    # the page it would open
+    problems = state_problems(state.model_dump(mode="json", by_alias=True, exclude_unset=True))
+    if problems:
+        raise HTTPException(
+            422, [{"field": f"token.{p['field']}", "message": p["message"]} for p in problems]
+        )
+    return state
 
 
 def page_query(state: ShareState) -> str:
@@ -459,10 +472,6 @@ def page_query(state: ShareState) -> str:
 
 
 # ------------------------------------------------------------------------ page query string
-
-#: Keys of the page's query string that are not values of the scene.
-_PAGE_SETTINGS = {"method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture"}
-_PAGE_SETTINGS |= {"phase", "step", "from", "fps"}
 
 
 def _page_request(scene_id: str, http: Request) -> SimulateRequest:

@@ -127,7 +127,16 @@ def get_posted_module(digest: str, request: Request) -> Response:
     """The module ``POST /live`` printed, immutable under its hash."""
     source = _POSTED.get(digest)
     if source is None:
-        raise HTTPException(status_code=404, detail="no such module here: post the scene again")
+        raise HTTPException(
+            status_code=404,
+            detail=[
+                {
+                    "field": "digest",
+                    "message": f"no module '{digest[:80]}' here (this server keeps a posted "
+                    "scene's module a while after POST /api/v1/scenes/live): post the scene again",
+                }
+            ],
+        )
     return _cached(request, source, digest, "text/javascript", IMMUTABLE)
 
 

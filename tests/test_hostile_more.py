@@ -1,0 +1,155 @@
+"""Found by a second hostile play-test (share links, predictions, nested powers, live modules,
+parse errors): each bad input is a 4xx in the one error shape naming its field, with a message
+that says what is wrong, never a 500 and never a wrong answer."""
+
+from __future__ import annotations
+
+import base64
+import json
+import zlib
+
+import pytest
+from fastapi.testclient import TestClient
+
+from app.main import app
+from mechanics.scenes import load_scene, scene_ids
+
+client = TestClient(app)
+
+
+def one_problem(response, status: int) -> dict[str, str]:
+    assert response.status_code == status, response.text
+    (problem,) = response.json()["detail"]
+    assert set(problem) == {"field", "message"}
+    return problem
+
+
+def token_of(state: dict) -> str:
+    """A hand-made token (the format: 'z' + base64url of zlib of JSON), as an attacker makes it."""
+    raw = zlib.compress(json.dumps(state).encode())
+    return "z" + base64.urlsafe_b64encode(raw).decode().rstrip("=")
+
+
+# --- 1. share links: the scene must exist and its values must be the scene's -----------------
+
+#: The page's own query keys (static/js/controls.js writeQuery, scene.js), written out here.
+PAGE_KEYS = ["method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture", "phase"]
+PAGE_KEYS += ["step", "from", "fps"]
+
+
+def test_a_share_of_an_unknown_scene_is_a_404_naming_scene_id():
+    r = client.post("/api/v1/export/share", json={"scene_id": "no_such_scene"})
+    problem = one_problem(r, 404)
+    assert problem["field"] == "scene_id"
+    assert "unknown scene 'no_such_scene'" in problem["message"]
+    assert "GET /api/v1/scenes" in problem["message"]
+
+
+@pytest.mark.parametrize("name", ["t_end", "method", "step", "dt", "lecture"])
+def test_a_share_with_a_parameter_named_like_a_page_setting_is_refused(name):
+    state = {"scene_id": "simple_pendulum", "parameters": {name: 3.0}}
+    problem = one_problem(client.post("/api/v1/export/share", json=state), 422)
+    assert problem["field"] == f"parameters.{name}"
+    assert "setting of the page" in problem["message"] and name in problem["message"]
+
+
+def test_a_share_with_values_the_scene_does_not_have_names_each():
+    state = {
+        "scene_id": "simple_pendulum",
+        "parameters": {"k": 1.0},
+        "initial": {"phi": 0.5, "theta": 1.0},
+        "phase": "x",
+    }
+    r = client.post("/api/v1/export/share", json=state)
+    assert r.status_code == 422, r.text
+    problems = {p["field"]: p["message"] for p in r.json()["detail"]}
+    assert set(problems) == {"parameters.k", "initial.phi", "phase"}
+    # the pendulum's own names (its TOML: m, l, g; theta) are listed to choose from
+    assert "m" in problems["parameters.k"] and "g" in problems["parameters.k"]
+    assert "theta_dot" in problems["initial.phi"]
+    assert "theta" in problems["phase"]
+
+
+@pytest.mark.parametrize(
+    "state, field, says",
+    [
+        ({"scene_id": "no_such_scene"}, "token.scene_id", "unknown scene"),
+        (
+            {"scene_id": "simple_pendulum", "parameters": {"t_end": 3}},
+            "token.parameters.t_end",
+            "page",
+        ),
+        (
+            {"scene_id": "simple_pendulum", "parameters": {"step": 2}},
+            "token.parameters.step",
+            "page",
+        ),
+        ({"scene_id": "simple_pendulum", "initial": {"method": 1}}, "token.initial.method", "page"),
+        (
+            {"scene_id": "simple_pendulum", "parameters": {"k": 1}},
+            "token.parameters.k",
+            "no parameter",
+        ),
+    ],
+)
+def test_a_hand_edited_token_is_refused_when_it_is_opened(state, field, says):
+    token = token_of(state)
+    for url in (f"/api/v1/export/share/{token}", f"/s/{token}"):
+        problem = one_problem(client.get(url, follow_redirects=False), 422)
+        assert problem["field"] == field
+        assert says in problem["message"]
+
+
+def test_a_posted_specs_share_checks_its_overrides_against_that_spec():
+    spec = load_scene("simple_pendulum")
+    good = client.post("/api/v1/export/share", json={"scene": spec, "parameters": {"l": 2.0}})
+    assert good.status_code == 200, good.text
+    r = client.post("/api/v1/export/share", json={"scene": spec, "parameters": {"L": 2.0}})
+    problem = one_problem(r, 422)
+    assert problem["field"] == "parameters.L" and "posted scene" in problem["message"]
+
+
+def test_no_built_in_scene_names_a_value_like_a_page_setting():
+    """Otherwise its own links could not be told apart from the page's settings."""
+    for scene_id in scene_ids():
+        spec = load_scene(scene_id)
+        names = set(spec.get("parameters") or {}) | set(spec["coordinates"])
+        names |= {f"{q}_dot" for q in spec["coordinates"]}
+        assert not names & set(PAGE_KEYS), scene_id
+
+
+def test_a_honest_builtin_share_still_opens_its_page():
+    state = {"scene_id": "double_pendulum", "parameters": {"m2": 2.0}, "initial": {"theta1": 1}}
+    link = client.post("/api/v1/export/share", json={**state, "phase": "theta2"}).json()
+    opened = client.get(link["url"], follow_redirects=False)
+    assert opened.status_code == 303
+    assert opened.headers["location"].startswith("/scenes/double_pendulum?m2=2.0&theta1=1.0")
+
+
+# --- 4. 404s of the live modules ------------------------------------------------------------
+
+
+def test_the_live_module_of_an_unknown_scene_says_so_and_where_the_ids_are():
+    for url in ("/api/v1/scenes/no_such_scene/live.js", "/api/v1/scenes/no_such_scene/live"):
+        problem = one_problem(client.get(url), 404)
+        assert problem["field"] == "scene_id"
+        assert "unknown scene 'no_such_scene'" in problem["message"]
+        assert "GET /api/v1/scenes" in problem["message"]
+
+
+def test_every_unknown_scene_404_reads_the_same():
+    """/derive, /check (through the pool's gate), /simulate and live.js say it in one sentence."""
+    answers = [
+        client.get("/api/v1/scenes/nope/live.js"),
+        client.post("/api/v1/derive", json={"scene_id": "nope"}),
+        client.post("/api/v1/check", json={"scene_id": "nope", "quantity": "T", "answer": "1"}),
+        client.post("/api/v1/simulate", json={"scene_id": "nope"}),
+    ]
+    messages = {one_problem(r, 404)["message"] for r in answers}
+    assert messages == {"unknown scene 'nope' (GET /api/v1/scenes lists the scene ids)"}
+
+
+def test_a_missing_posted_module_names_its_digest_not_a_scene():
+    problem = one_problem(client.get("/api/v1/scenes/live/0123456789abcdef.js"), 404)
+    assert problem["field"] == "digest"
+    assert "post the scene again" in problem["message"]
