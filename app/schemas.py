@@ -22,6 +22,9 @@ SceneId = Annotated[str, StringConstraints(pattern=r"^[a-z0-9_]{1,64}$")]
 #: value is a 422 naming the field, like every other bad value.
 MethodName = Literal[tuple(METHODS)]  # type: ignore[valid-type]
 Quantity = Literal[QUANTITIES]  # type: ignore[valid-type]
+#: A number a request may carry: NaN and ±Infinity (which Python's JSON reader accepts) are a 422
+#: "Input should be a finite number" on their field, said before any range the field has.
+Finite = Annotated[float, Field(allow_inf_nan=False)]
 
 
 class ErrorDetail(BaseModel):
@@ -183,12 +186,12 @@ class SimulateRequest(DeriveRequest):
         },
     )
 
-    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
-    initial: dict[str, float] = Field(
+    parameters: dict[str, Finite] = Field(default={}, description="Overrides of the defaults.")
+    initial: dict[str, Finite] = Field(
         default={}, description="Initial q and q_dot (`theta`, `theta_dot`); default the scene's."
     )
-    t_end: float = Field(default=10.0, description="Seconds of motion (≤ 1000).")
-    fps: float = Field(
+    t_end: Finite = Field(default=10.0, description="Seconds of motion (≤ 1000).")
+    fps: Finite = Field(
         default=60.0,
         description="Output samples per second (> 0), as many as t_end × fps + 1 ≤ 20001 "
         "samples allow: 100 samples over 1 ms is fps = 1e5.",
@@ -199,9 +202,9 @@ class SimulateRequest(DeriveRequest):
         "RK45, DOP853, dop853_c, dop853_fortran, Radau, BDF, LSODA (adaptive: rtol, atol); "
         "`GET /api/v1/methods` lists each with its order and properties.",
     )
-    rtol: float = Field(default=1e-9, description="Relative tolerance (adaptive methods).")
-    atol: float = Field(default=1e-9, description="Absolute tolerance (adaptive methods).")
-    dt: float | None = Field(default=None, description="Step (fixed-step methods).")
+    rtol: Finite = Field(default=1e-9, description="Relative tolerance (adaptive methods).")
+    atol: Finite = Field(default=1e-9, description="Absolute tolerance (adaptive methods).")
+    dt: Finite | None = Field(default=None, description="Step (fixed-step methods).")
     check_sensitivity: bool = Field(
         default=True,
         description="Re-run at a 1000× looser tolerance and warn if the motion is sensitive.",
@@ -368,11 +371,11 @@ class PredictRequest(CheckRequest):
         },
     )
 
-    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
-    initial: dict[str, float] = Field(
+    parameters: dict[str, Finite] = Field(default={}, description="Overrides of the defaults.")
+    initial: dict[str, Finite] = Field(
         default={}, description="Overrides of the initial state (q and q_dot by name)."
     )
-    t_end: float = Field(default=5.0, gt=0, le=10, description="Seconds to integrate (≤ 10).")
+    t_end: Finite = Field(default=5.0, gt=0, le=10, description="Seconds to integrate (≤ 10).")
 
 
 class PredictedRun(BaseModel):
@@ -433,7 +436,7 @@ class EquilibriaRequest(DeriveRequest):
         json_schema_extra={"examples": [{"scene_id": "bead_on_hoop", "parameters": {"Omega": 6}}]},
     )
 
-    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
+    parameters: dict[str, Finite] = Field(default={}, description="Overrides of the defaults.")
 
 
 class Equilibrium(BaseModel):

@@ -134,11 +134,9 @@ def compile_model(d: Derivation, rows: list[sp.Expr]) -> Any:
     return sp.lambdify(args, exprs, modules=_MATH, cse=True)
 
 
-def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: float) -> Run:
-    """DOP853 step by step, sampled on a uniform grid; stops at a blow-up, a singular q̈, the
-    step cap or the wall-time cap, keeping what it has."""
-    samples = min(MAX_SAMPLES, int(t_end * SAMPLES_PER_SECOND) + 1)
-    grid = np.linspace(0.0, t_end, samples)
+def _rhs(fn: Any, n: int, params: list[float]) -> Any:
+    """The first-order right-hand side (q̇, q̈) of a compiled model at these parameters; raises
+    _Stop where q̈ is singular or not finite."""
 
     def rhs(time_: float, y: np.ndarray) -> np.ndarray:
         state = y.tolist()
@@ -165,6 +163,15 @@ def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: floa
             raise _Stop(_SINGULAR) from None
         return np.concatenate([y[n:], qdd])
 
+    return rhs
+
+
+def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: float) -> Run:
+    """DOP853 step by step, sampled on a uniform grid; stops at a blow-up, a singular q̈, the
+    step cap or the wall-time cap, keeping what it has. _Stop when it cannot start at all."""
+    samples = min(MAX_SAMPLES, int(t_end * SAMPLES_PER_SECOND) + 1)
+    grid = np.linspace(0.0, t_end, samples)
+    rhs = _rhs(fn, n, params)
     out = np.empty((samples, 2 * n))
     out[0] = y0
     rhs(0.0, np.asarray(y0, dtype=float))  # a model singular at the start is refused by the caller
@@ -221,6 +228,62 @@ def initial_state(
     y0 = [state.get(q, 0.0) for q in spec.coordinates]
     y0 += [state.get(f"{q}_dot", 0.0) for q in spec.coordinates]
     return [values[k] for k in spec.parameters], y0
+
+
+def cannot_start(
+    d: Derivation,
+    fn: Any,
+    parameters: dict[str, float],
+    initial: dict[str, float],
+    why: str,
+) -> list[dict[str, str]]:
+    """Why the DERIVED equations cannot start, naming the request's value that stops them.
+
+    The overrides are tried one at a time, each put back to the scene's own value: an override
+    without which the equations start is to blame (l = 0 leaves the pendulum without inertia:
+    ``parameters.l``). Failing that, all parameter overrides together, then the initial state's
+    (a pole of the coordinates, like φ at θ = 0); the scene's own start last (``initial``).
+    """
+    spec, n = d.model.spec, len(d.model.q)
+
+    def starts(params: dict[str, float], state: dict[str, float]) -> bool:
+        values = {**spec.parameters, **params}
+        start = {**spec.initial, **state}
+        y0 = [start.get(q, 0.0) for q in spec.coordinates]
+        y0 += [start.get(f"{q}_dot", 0.0) for q in spec.coordinates]
+        try:
+            _rhs(fn, n, [values[k] for k in spec.parameters])(0.0, np.asarray(y0, dtype=float))
+        except _Stop:
+            return False
+        return True
+
+    hints = {
+        "parameters": "; a mass, length or inertia of 0 leaves a coordinate without inertia",
+        "initial": "; the coordinates may be singular there (like φ at θ = 0 of spherical "
+        "coordinates): start elsewhere",
+    }
+
+    def blame(where: str, given: dict[str, float]) -> list[dict[str, str]]:
+        hint = hints[where] if why == _SINGULAR else ""
+        return [
+            {
+                "field": f"{where}.{name}",
+                "message": f"with {name} = {value:g} the scene's motion cannot start: {why}{hint}",
+            }
+            for name, value in given.items()
+        ]
+
+    for name in parameters:
+        if starts({k: v for k, v in parameters.items() if k != name}, initial):
+            return blame("parameters", {name: parameters[name]})
+    if parameters and starts({}, initial):
+        return blame("parameters", parameters)
+    for name in initial:
+        if starts(parameters, {k: v for k, v in initial.items() if k != name}):
+            return blame("initial", {name: initial[name]})
+    if initial and starts(parameters, {}):
+        return blame("initial", initial)
+    return [{"field": "initial", "message": f"the scene's motion cannot start here: {why}"}]
 
 
 class _Drawing:
@@ -330,6 +393,8 @@ def predict(
         raise SpecError(
             [{"field": "quantity", "message": f"a prediction needs one of {', '.join(PREDICTED)}"}]
         )
+    if not math.isfinite(t_end):
+        raise SpecError([{"field": "t_end", "message": "must be a finite number"}])
     if not (0 < t_end <= MAX_T_END):
         raise SpecError([{"field": "t_end", "message": f"must be in (0, {MAX_T_END:g}] seconds"}])
     verdict = check(d, quantity, answer, coordinate)
@@ -357,12 +422,7 @@ def predict(
         true = integrate(true_fn, n, y0, params, t_end)
     except _Stop as stop:
         raise SpecError(
-            [
-                {
-                    "field": "initial",
-                    "message": f"the derived equations cannot start here: {stop.why}",
-                }
-            ]
+            cannot_start(d, true_fn, parameters or {}, initial or {}, stop.why)
         ) from None
     try:
         student = integrate(student_fn, n, y0, params, t_end)

@@ -153,3 +153,97 @@ def test_a_missing_posted_module_names_its_digest_not_a_scene():
     problem = one_problem(client.get("/api/v1/scenes/live/0123456789abcdef.js"), 404)
     assert problem["field"] == "digest"
     assert "post the scene again" in problem["message"]
+
+
+# --- 2. predict (and simulate, precision): the field and the words of a bad number ----------
+
+
+def predict(**fields):
+    body = {"scene_id": "simple_pendulum", "quantity": "eom", "coordinate": "theta"}
+    body["answer"] = "theta'' + g/l sin(theta) = 0"
+    return client.post("/api/v1/check/predict", json={**body, **fields})
+
+
+def nan_post(url: str, body: str):
+    """Python's JSON reader takes NaN and Infinity: a client may send them."""
+    return client.post(url, content=body, headers={"content-type": "application/json"})
+
+
+@pytest.mark.parametrize("literal", ["NaN", "Infinity", "-Infinity"])
+def test_a_non_finite_t_end_is_said_to_be_not_finite(literal):
+    body = (
+        '{"scene_id": "simple_pendulum", "quantity": "accel", "coordinate": "theta", '
+        f'"answer": "-g/l sin(theta)", "t_end": {literal}}}'
+    )
+    problem = one_problem(nan_post("/api/v1/check/predict", body), 422)
+    assert problem["field"] == "t_end"
+    assert "finite number" in problem["message"] and "10" not in problem["message"]
+
+
+@pytest.mark.parametrize(
+    "url, body, field",
+    [
+        ("/api/v1/simulate", '{"scene_id": "simple_pendulum", "t_end": NaN}', "t_end"),
+        ("/api/v1/simulate", '{"scene_id": "simple_pendulum", "fps": Infinity}', "fps"),
+        ("/api/v1/simulate", '{"scene_id": "simple_pendulum", "method": "rk4", "dt": NaN}', "dt"),
+        ("/api/v1/simulate", '{"scene_id": "simple_pendulum", "rtol": NaN}', "rtol"),
+        (
+            "/api/v1/simulate",
+            '{"scene_id": "simple_pendulum", "initial": {"theta": NaN}}',
+            "initial.theta",
+        ),
+        ("/api/v1/precision", '{"scene_id": "simple_pendulum", "t_end": NaN}', "t_end"),
+        ("/api/v1/precision", '{"scene_id": "simple_pendulum", "steps": [0.1, NaN]}', "steps[1]"),
+        (
+            "/api/v1/precision",
+            '{"scene_id": "simple_pendulum", "tolerances": [Infinity]}',
+            "tolerances[0]",
+        ),
+        (
+            "/api/v1/precision",
+            '{"scene_id": "simple_pendulum", "parameters": {"l": NaN}}',
+            "parameters.l",
+        ),
+        (
+            "/api/v1/equilibria",
+            '{"scene_id": "simple_pendulum", "parameters": {"g": NaN}}',
+            "parameters.g",
+        ),
+        (
+            "/api/v1/check/predict",
+            '{"scene_id": "simple_pendulum", "quantity": "T", "answer": "m", '
+            '"initial": {"theta": NaN}}',
+            "initial.theta",
+        ),
+    ],
+)
+def test_every_non_finite_number_is_said_to_be_not_finite_on_its_field(url, body, field):
+    problem = one_problem(nan_post(url, body), 422)
+    assert problem["field"] == field
+    assert "finite number" in problem["message"]
+
+
+def test_a_zero_length_pendulum_blames_the_parameter_not_the_initial_state():
+    """With l = 0 the pendulum's m l² θ̈ has no inertia: θ̈ is undetermined for any start."""
+    problem = one_problem(predict(parameters={"l": 0}), 422)
+    assert problem["field"] == "parameters.l"
+    assert "l = 0" in problem["message"] and "cannot start" in problem["message"]
+
+
+def test_a_zero_mass_among_harmless_overrides_is_the_one_blamed():
+    problem = one_problem(predict(parameters={"g": 3.0, "m": 0, "l": 2.0}), 422)
+    assert problem["field"] == "parameters.m" and "m = 0" in problem["message"]
+
+
+def test_a_singular_start_of_the_coordinates_blames_that_initial_value():
+    """The spherical pendulum's φ has no inertia at θ = 0 (m l² sin²θ φ̈): the start is blamed."""
+    body = {
+        "scene_id": "spherical_pendulum",
+        "quantity": "accel",
+        "coordinate": "theta",
+        "answer": "-g/l sin(theta)",
+        "initial": {"theta": 0.0},
+    }
+    problem = one_problem(client.post("/api/v1/check/predict", json=body), 422)
+    assert problem["field"] == "initial.theta"
+    assert "theta = 0" in problem["message"]

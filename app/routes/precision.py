@@ -18,7 +18,7 @@ from app.derivations import derive_seconds, in_pool, in_process, posted_key
 from app.memo import AnswerMemo
 from app.responses import dumps
 from app.routes.scenes import unknown_scene
-from app.schemas import DeriveRequest, Message, MethodName, ValidationErrors
+from app.schemas import DeriveRequest, Finite, Message, MethodName, ValidationErrors
 from mechanics.scenes import scene_ids
 
 router = APIRouter(prefix="/api/v1", tags=["precision"])
@@ -48,27 +48,27 @@ class PrecisionIn(DeriveRequest):
         },
     )
 
-    parameters: dict[str, float] = Field(default={}, description="Overrides of the defaults.")
-    initial: dict[str, float] = Field(default={}, description="Initial q and q_dot.")
+    parameters: dict[str, Finite] = Field(default={}, description="Overrides of the defaults.")
+    initial: dict[str, Finite] = Field(default={}, description="Initial q and q_dot.")
     methods: list[MethodName] = Field(  # type: ignore[valid-type]
         default=["euler", "rk4", "DOP853"],
         min_length=1,
         max_length=6,
         description="Up to 6 methods of `GET /api/v1/methods`, each once.",
     )
-    steps: list[float] | None = Field(
+    steps: list[Finite] | None = Field(
         default=None,
         max_length=8,
         description="Steps (s) for the fixed-step methods, up to 8; default t_end/100 … "
         "t_end/3200. At most 200000 steps a run.",
     )
-    tolerances: list[float] | None = Field(
+    tolerances: list[Finite] | None = Field(
         default=None,
         max_length=8,
         description="rtol = atol for the adaptive methods, up to 8 in [1e-12, 0.01]; default "
         "1e-4 … 1e-10.",
     )
-    t_end: float = Field(default=10.0, description="Seconds of motion (≤ 100).")
+    t_end: Finite = Field(default=10.0, description="Seconds of motion (≤ 100).")
     long_run: bool = Field(
         default=False,
         description="Also symplectic Euler against RK4 at one step over 1000 periods (≤ 8 s).",
