@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from scipy.integrate import cumulative_simpson
 
-from mechanics.divergence import compare_runs
+from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
@@ -507,6 +507,8 @@ def _sensitivity(c, params, y0, t_eval, req, run) -> list[str]:
     loose = _run(c, params, y0, t_eval, req, rtol, atol)
     shared = min(len(loose.t), len(run.t) - (1 if run.status == "stopped" else 0))
     if loose.status != "ok" and len(loose.t) < len(run.t) or shared < 3:
+        return []
+    if not worth_classifying(c.n, run.y[:shared], loose.y[:shared]):
         return []
     verdict = compare_runs(
         c, params, run.t[:shared], run.y[:shared], loose.y[:shared], (req.rtol, rtol)

@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 from mechanics.divergence import (
+    SILENT_BELOW,
     TimeShift,
     best_time_shift,
     chaos_possible,
     classify_divergence,
     is_autonomous,
+    worth_classifying,
 )
 
 T = np.linspace(0.0, 20.0, 1201)  # 20 s at 60 fps, as the app samples
@@ -185,3 +187,58 @@ def test_autonomy_is_read_off_the_equations():
 def test_a_mismatch_of_lengths_is_an_error():
     with pytest.raises(ValueError):
         classify_divergence(T, np.zeros(3), 1.0, 2, True)
+
+
+def _shapes(t: np.ndarray, rng: np.random.Generator) -> list[np.ndarray]:
+    """Growth laws the classifier tells apart, each up to 1 (scaled by the caller)."""
+    wobble = 1 + 0.3 * np.sin(7 * t)
+    return [
+        np.exp(2.0 * (t - t[-1])),  # chaos
+        (t / t[-1]) ** 1.0 * wobble,  # a drift in phase
+        (t / t[-1]) ** 2.0,
+        np.abs(np.sin(3 * t)) * (t / t[-1]),
+        np.abs(rng.normal(size=t.size)),  # no law
+        np.where(t > 0.5 * t[-1], 1.0, 1e-6),  # a step
+    ]
+
+
+@pytest.mark.parametrize("autonomous", [True, False])
+def test_below_the_silent_level_no_growth_law_has_anything_to_say(autonomous):
+    """Why simulate may skip the fits (worth_classifying): whatever the shape, runs that part
+    by less than SILENT_BELOW of the span get no sentence; just above it, some do."""
+    rng = np.random.default_rng(3)
+    t = np.linspace(0.0, 10.0, 301)
+    said_above = 0
+    for d in _shapes(t, rng):
+        d = d / np.max(d)
+        quiet = classify_divergence(t, 0.999 * SILENT_BELOW * d, 1.0, 2, autonomous)
+        assert quiet.message == ""
+        loud = classify_divergence(t, 30 * SILENT_BELOW * d, 1.0, 2, autonomous)
+        said_above += bool(loud.message)
+    assert said_above >= 3
+
+
+def test_worth_classifying_reads_the_largest_relative_difference_of_any_coordinate():
+    t = np.linspace(0, 1, 50)
+    y = np.column_stack([np.sin(t), 100 * np.cos(t), np.zeros_like(t), np.zeros_like(t)])
+    other = y.copy()
+    other[:, 1] += 0.5 * SILENT_BELOW * 100  # half the level, relative to q2's span of 100
+    assert not worth_classifying(2, y, other)
+    other[:, 0] += 2 * SILENT_BELOW * np.max(np.abs(np.sin(t)))  # twice it, in q1
+    assert worth_classifying(2, y, other)
+    other[:, 2] += 1.0  # velocities are not compared (compare_runs looks at coordinates)
+    other[:, 0] = y[:, 0]
+    assert not worth_classifying(2, y, other)
+    other[5, 1] = np.nan  # a run that blew up is looked at
+    assert worth_classifying(2, y, other)
+
+
+@pytest.mark.parametrize("scene_id", ["double_pendulum", "simple_pendulum", "bead_on_hoop"])
+@pytest.mark.parametrize("rtol", [1e-9, 1e-5])
+def test_skipping_the_fits_changes_no_warning(scene_id, rtol, monkeypatch):
+    from mechanics import simulate as sim
+
+    req = sim.SimulationRequest(t_end=20, fps=30, method="dop853_c", rtol=rtol, atol=rtol)
+    fast = sim.simulate(scene_id, None, req)["warnings"]
+    monkeypatch.setattr(sim, "worth_classifying", lambda *a: True)
+    assert sim.simulate(scene_id, None, req)["warnings"] == fast
