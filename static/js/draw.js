@@ -3,7 +3,8 @@
 // A run that travels far (a disk rolling down a long slope) gets a camera that pans with it at one
 // fixed scale, never zooming out. The stages of one page that show the same spec (compare mode:
 // two methods side by side) share one scale, fitted to the union of their runs, so equal
-// distances look equal. The page's first stage carries the instruments (instruments.js).
+// distances look equal. The page's first stage carries the instruments (instruments.js). In a
+// 3-D view a drag turns the camera, unless it starts on a body (livedrag.js moves that body).
 import { SceneGeometry } from "./geometry.js";
 import { Instruments } from "./instruments.js";
 import { drawCanvas } from "./render.js";
@@ -27,6 +28,11 @@ export class Stage {
     this.frame = 0;
     this.yaw = 0.55;
     this.pitch = 0.4;
+    /** (pointerdown event) => true when the pointer takes a body (livedrag.js), which a 3-D
+     * view's drag then moves instead of turning the camera. */
+    this.grabs = null;
+    /** () => whether bodies can be dragged here (the note on a 3-D canvas says so). */
+    this.placeable = () => false;
     this.canvas.addEventListener("pointerdown", (e) => this.#drag(e));
     new ResizeObserver(() => this.#resize()).observe(canvas);
     this.#resize();
@@ -113,6 +119,33 @@ export class Stage {
     this.canvas.dataset.scale = this.view.scale.toPrecision(6);
   }
 
+  /** Show the run in `view` (the one a body was dragged in) instead of the fitted one, so the
+   * world does not move, nor the scale jump, under the user's hand. `force` (during a drag)
+   * keeps it whatever the run; otherwise only when the whole run fits in it (a body dragged
+   * far out needs the wider view) — a following camera keeps the scale and follows. Returns
+   * whether the view was kept. */
+  keep(view, force = false) {
+    const g = this.geom;
+    if (!g || !view || view.is3D !== g.is3D) return false;
+    if (!force && this.follow) {
+      this.view.scale = view.scale;
+      this.canvas.dataset.scale = view.scale.toPrecision(6);
+      return true;
+    }
+    if (!force && !view.contains(g.extent())) return false;
+    if (view.w !== this.cssW || view.h !== this.cssH) { // a new layout changed the canvas' shape
+      if (view.w !== this.cssW) return false; // the page was resized meanwhile: fitted anew
+      this.aspect = view.h / view.w;
+      this.cssW = 0;
+      this.#resize();
+    }
+    Object.assign(view, { yaw: this.yaw, pitch: this.pitch });
+    this.view = view;
+    this.follow = false;
+    this.canvas.dataset.scale = view.scale.toPrecision(6);
+    return true;
+  }
+
   draw(i) {
     const g = this.geom;
     if (!g) return;
@@ -126,7 +159,8 @@ export class Stage {
     const shapes = sceneShapes(g, this.view, this.frame, {
       radius: font - 1, trail: g.is3D ? 3 : 1.5, scaleBar: true, font,
     });
-    const note = g.is3D ? "drag to turn the view" : this.follow ? "camera follows the motion" : "";
+    const turn = this.placeable() ? "drag a body to place it, drag elsewhere to turn the view" : "drag to turn the view";
+    const note = g.is3D ? turn : this.follow ? "camera follows the motion" : "";
     if (note) shapes.push({ t: "text", at: [10, 8 + font], text: note, color: "#868e96", size: font });
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
@@ -137,7 +171,7 @@ export class Stage {
   }
 
   #drag(e) {
-    if (!this.geom || !this.geom.is3D) return;
+    if (!this.geom || !this.geom.is3D || this.grabs?.(e)) return;
     e.preventDefault();
     const x0 = e.clientX, y0 = e.clientY, yaw0 = this.yaw, pitch0 = this.pitch;
     const move = (m) => {
@@ -155,3 +189,4 @@ export class Stage {
     window.addEventListener("pointerup", up);
   }
 }
+

@@ -3,8 +3,11 @@
 // inverting the stage's view; the coordinates that put the dragged body there come from the scene's
 // own position functions (live.js: damped Gauss–Newton), so a double pendulum's lower bob moves
 // both angles and a bead stays on its hoop. Nothing is asked of the server while dragging: the
-// live preview redraws each animation frame; the server's run is asked for on release.
-// Planar scenes only: in a 3-D view a drag turns the camera (draw.js).
+// live preview redraws each animation frame; the server's run is asked for on release, and the
+// motion plays from the new start in the view it was dragged in (no jump of scale).
+// In a 3-D view a drag that starts on a body moves it on the plane through it parallel to the
+// screen (drag3d.js); one that starts elsewhere turns the camera (draw.js).
+import { placeOnScreen, velocityOnScreen, movers } from "./drag3d.js";
 import { unproject } from "./live.js";
 
 const PICK_PX = 30; // how near the pointer must be to a body to grab it
@@ -17,14 +20,22 @@ export class BodyDrag {
     this.sv = sceneView;
     this.canvas = $("canvas");
     this.drag = null;
+    this.kept = null; // {view, changes}: the view of the last drag, kept while nothing else changed
+    this.hovered = null;
     this.velocityMode = false;
+    const stage = sceneView.stageA;
+    stage.grabs = (e) => e.button <= 0 && Boolean(this.#usable() && this.#grab(this.#local(e)));
+    stage.placeable = () => Boolean(this.#usable());
     this.canvas.addEventListener("pointerdown", (e) => this.#down(e));
     this.canvas.addEventListener("pointermove", (e) => this.#hover(e));
+    this.canvas.addEventListener("pointerleave", () => { if (!this.drag) this.#highlight(null); });
     this.#toggle();
   }
 
+  /** A body is being moved: the animation holds its start (until the pointer moves after the
+   * press, the motion goes on, so a click on a body changes nothing). */
   get active() {
-    return this.drag !== null;
+    return Boolean(this.drag?.moved);
   }
 
   /** The button beside the playback controls that makes a drag set the velocity instead. */
@@ -44,7 +55,7 @@ export class BodyDrag {
 
   #usable() {
     const { live, shown, stageA } = this.sv;
-    return live && shown && stageA.geom && !stageA.geom.is3D && stageA.view;
+    return live && shown && stageA.geom && stageA.view;
   }
 
   /** Pointer position in the canvas's CSS pixels (the view's units). */
@@ -68,42 +79,82 @@ export class BodyDrag {
     return best;
   }
 
+  /** The body a press at `at` takes: the one drawn nearest (within PICK_PX) that some
+   * coordinate moves; null when the press is for the camera. */
+  #grab(at) {
+    const body = this.#pick(at);
+    if (!body) return null;
+    const { live, initial, params } = this.sv;
+    return movers(live, body, live.state(initial), live.paramVector(params)).length ? body : null;
+  }
+
   #hover(e) {
     if (this.drag || !this.#usable()) return;
-    this.canvas.style.cursor = this.#pick(this.#local(e)) ? "grab" : "";
+    this.#highlight(this.#pick(this.#local(e)));
+  }
+
+  /** The grab cursor and a ring around the body a press would take. */
+  #highlight(body) {
+    this.hovered = body;
+    this.canvas.style.cursor = body ? "grab" : "";
+  }
+
+  /** The state the run on the canvas passes through at its drawn frame (q, and q̇ = 0). */
+  #drawnState(fallback) {
+    const { shown, live, stageA } = this.sv;
+    const y = Float64Array.from(fallback);
+    live.meta.coordinates.forEach((q, j) => {
+      const v = shown.q?.[q]?.[stageA.frame];
+      if (Number.isFinite(v)) y[j] = v;
+      y[live.n + j] = 0;
+    });
+    return y;
   }
 
   #down(e) {
     if (!this.#usable() || e.button > 0) return;
     const at = this.#local(e);
-    const body = this.#pick(at);
+    const body = this.#grab(at);
     if (!body) return;
     e.preventDefault();
     e.stopImmediatePropagation();
     const sv = this.sv;
     const live = sv.live;
+    const st = sv.stageA;
     this.canvas.setPointerCapture?.(e.pointerId);
     this.canvas.style.cursor = "grabbing";
+    const velocity = this.velocityMode || e.shiftKey;
+    const start = live.state(sv.initial);
+    // A position drag starts from the pose on the screen (the body is taken where it is seen,
+    // which keeps a double pendulum's elbow or a bob's side of its sphere); a velocity drag
+    // gives the starting pose a velocity.
+    const y = velocity ? start : this.#drawnState(start);
     this.drag = {
-      body, velocity: this.velocityMode || e.shiftKey, at, view: sv.stageA.view,
-      y: live.state(sv.initial), p: live.paramVector(sv.params),
+      body, velocity, at, view: st.view, y, p: live.paramVector(sv.params), moved: false,
+      depth: st.view.project(st.geom.at(body, st.frame))[2],
+      positive: (sv.spec.positive_coordinates || []).map((q) => live.meta.coordinates.indexOf(q)).filter((j) => j >= 0),
     };
-    this.wasPlaying = sv.playing;
-    sv.time = 0;
-    const move = (m) => { this.drag.at = this.#local(m); this.#apply(); };
+    const move = (m) => {
+      this.drag.at = this.#local(m);
+      this.drag.moved = true;
+      this.#apply();
+    };
     const up = () => {
       this.canvas.removeEventListener("pointermove", move);
       this.canvas.removeEventListener("pointerup", up);
       this.canvas.removeEventListener("pointercancel", up);
-      this.canvas.style.cursor = "";
+      const d = this.drag;
       this.drag = null;
+      this.#highlight(null);
+      if (!d.moved) return; // a click on a body changes nothing
+      this.kept = { view: d.view, changes: sv.changes };
       sv.time = 0;
+      if (!sv.playing) sv.togglePlay(); // it swings from where it was let go
       sv.schedule(0); // the server's run of the new start
     };
     this.canvas.addEventListener("pointermove", move);
     this.canvas.addEventListener("pointerup", up);
     this.canvas.addEventListener("pointercancel", up);
-    this.#apply();
   }
 
   /** The state the pointer asks for, into the controls and the preview. */
@@ -111,11 +162,21 @@ export class BodyDrag {
     const d = this.drag;
     const live = this.sv.live;
     const here = live.places(d.y, d.p)[d.body];
-    const target = unproject(d.view, d.at[0], d.at[1], here[2]);
-    if (d.velocity) {
+    if (d.view.is3D) {
+      if (d.velocity) {
+        const target = d.view.unproject(d.at[0], d.at[1], d.view.project(here)[2]);
+        const v = [0, 1, 2].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS);
+        d.y = velocityOnScreen(live, d.body, d.view, v, d.y, d.p);
+      } else {
+        d.y = placeOnScreen(live, d.body, d.view, d.at, d.depth, d.y, d.p, { positive: d.positive });
+        for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
+      }
+    } else if (d.velocity) {
+      const target = unproject(d.view, d.at[0], d.at[1], here[2]);
       const v = [0, 1].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS).concat(0);
       d.y = live.velocityFor(d.body, v, d.y, d.p);
     } else {
+      const target = unproject(d.view, d.at[0], d.at[1], here[2]);
       d.y = live.reach(d.body, target, d.y, d.p);
       for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
     }
@@ -127,12 +188,17 @@ export class BodyDrag {
     this.sv.setInitial(values);
   }
 
-  /** Keep the view the drag started in (a refit would move the world under the pointer). */
+  /** Called whenever a new run is put on the canvas: keep the view the drag started in (a refit
+   * would move the world under the pointer), and after the drag, while nothing else changed,
+   * for the runs of the new start (the preview's last frame, the server's run) if they fit. */
   freeze() {
-    if (!this.drag) return;
     const st = this.sv.stageA;
-    st.view = this.drag.view;
-    st.follow = false;
+    if (this.drag) {
+      st.keep(this.drag.view, true);
+      return;
+    }
+    if (!this.kept) return;
+    if (this.kept.changes !== this.sv.changes || !st.keep(this.kept.view)) this.kept = null;
   }
 
   /** Drawn over the stage each frame: the velocity arrow while one is dragged, and (for tests and
@@ -149,6 +215,19 @@ export class BodyDrag {
       this.canvas.dataset.screen = JSON.stringify(pts);
     }
     const d = this.drag;
+    const ring = d ? d.body : this.hovered;
+    if (ring && st.geom.P[ring] && this.#usable()) {
+      const [x, y] = st.view.project(st.geom.at(ring, st.frame));
+      const ctx = st.ctx;
+      ctx.save();
+      ctx.strokeStyle = "#f08c00";
+      ctx.lineWidth = 2;
+      ctx.setLineDash([4, 3]);
+      ctx.beginPath();
+      ctx.arc(x, y, PICK_PX * 0.6, 0, 2 * Math.PI);
+      ctx.stroke();
+      ctx.restore();
+    }
     if (!d || !d.velocity) return;
     const from = st.view.project(st.geom.at(d.body, 0));
     const ctx = st.ctx;

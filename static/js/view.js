@@ -1,5 +1,5 @@
 // World (x, y, z in N) to screen pixels: the x–y plane for planar scenes, a perspective view for
-// 3-D ones (yaw and pitch change when the user drags).
+// 3-D ones (yaw and pitch change when the user drags); and back (unproject), for dragging a body.
 
 export class View {
   constructor(width, height, is3D = false) {
@@ -34,6 +34,14 @@ export class View {
     return this;
   }
 
+  /** Whether every point is drawn inside the canvas (a 3-D view: as the camera looks now). */
+  contains(points) {
+    return points.every((p) => {
+      const [x, y] = this.project(p);
+      return x >= 0 && x <= this.w && y >= 0 && y <= this.h;
+    });
+  }
+
   /** Screen [x, y], the depth toward the viewer, and the perspective factor. */
   project(p) {
     let x = p[0] - this.center[0], y = p[1] - this.center[1], z = p[2] - this.center[2];
@@ -47,6 +55,24 @@ export class View {
       x = x1; y = y2; z = z2;
     }
     return [this.w / 2 + x * this.scale * f, this.h / 2 - y * this.scale * f, z, f];
+  }
+
+  /** The camera's axes in world coordinates: screen right, screen up, and toward the viewer
+   * (project's depth is the component along the third). A planar view's are x, y, z. */
+  axes() {
+    if (!this.is3D) return [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+    const cy = Math.cos(this.yaw), sy = Math.sin(this.yaw);
+    const cp = Math.cos(this.pitch), sp = Math.sin(this.pitch);
+    return [[cy, 0, sy], [sp * sy, cp, -sp * cy], [-cp * sy, sp, cp * cy]];
+  }
+
+  /** The inverse of project: the world point drawn at screen (sx, sy) on the plane parallel to
+   * the screen at `depth` (project's third value). A dragged body is moved in that plane. */
+  unproject(sx, sy, depth = 0) {
+    const f = this.is3D ? this.camera / (this.camera - depth) : 1;
+    const x = (sx - this.w / 2) / (this.scale * f), y = -(sy - this.h / 2) / (this.scale * f);
+    const [ex, ey, ez] = this.axes();
+    return [0, 1, 2].map((k) => this.center[k] + x * ex[k] + y * ey[k] + depth * ez[k]);
   }
 
   /** The screen direction (unit, pixels) of a world direction d at world point p. */
