@@ -36,6 +36,13 @@ from sympy.printing.str import StrPrinter
 MAX_LENGTH = 2000
 MAX_DEPTH = 32
 MAX_EXPONENT = 64
+#: The largest degree nested powers may reach: exponents multiply when powers nest
+#: ((x**64)**64 is x**4096) and add when powers of one base multiply (x**64*x**64), so each
+#: exponent under MAX_EXPONENT is not enough; an answer of mechanics is of degree 2 to 8.
+MAX_DEGREE = 64
+#: How deep exponentials may nest (exp, sinh, cosh, a power with a variable exponent): exp(exp(x))
+#: is still a number a double holds for |x| < 6; exp(exp(exp(x))) overflows at x = 2.
+MAX_EXP_NESTING = 2
 MAX_DIGITS = 30
 # Every number must survive conversion to float64, because the simulator evaluates in floats.
 MAX_MAGNITUDE = sys.float_info.max
@@ -269,6 +276,39 @@ def _tree(text: object, field: str) -> tuple[ast.expr, int]:
         raise ExprError("expression too complex", field=field) from None
 
 
+_EXPONENTIAL = (sp.exp, sp.sinh, sp.cosh)
+
+
+@functools.lru_cache(maxsize=8192)
+def _degree(expr: sp.Basic) -> float:
+    """The degree that nested powers give ``expr``: a power multiplies its base's by
+    |exponent| (at least 1); a sum, a product and a function keep their largest part's (a
+    number is 0, a variable or derivative 1). A product of distinct factors is not counted
+    together: it costs nothing to expand, unlike a power of a power of a sum. Powers of one base
+    multiplied together are one power already (sympy writes x**40*x**40 as x**80)."""
+    if expr.is_number:
+        return 0.0
+    if isinstance(expr, sp.Pow):
+        base, exponent = expr.args
+        if exponent.is_number:
+            return _degree(base) * max(1.0, _magnitude(exponent))
+        return max(_degree(base), _degree(exponent), 1.0)
+    if isinstance(expr, sp.Add | sp.Mul | sp.Function) and not isinstance(expr, AppliedUndef):
+        return max([1.0, *(_degree(a) for a in expr.args)])
+    return 1.0  # a variable: a symbol, theta(t), a derivative of one
+
+
+@functools.lru_cache(maxsize=8192)
+def _exp_nesting(expr: sp.Basic) -> int:
+    """How many exponentials (exp, sinh, cosh, a power with a variable exponent) nest in expr."""
+    if expr.is_Atom or isinstance(expr, AppliedUndef | sp.Derivative):
+        return 0
+    inner = max(_exp_nesting(a) for a in expr.args)
+    if isinstance(expr, _EXPONENTIAL) or (isinstance(expr, sp.Pow) and not expr.exp.is_number):
+        return inner + 1
+    return inner
+
+
 class _Builder:
     """Turns a checked syntax tree into sympy, bottom-up, refusing anything off the whitelist."""
 
@@ -324,7 +364,7 @@ class _Builder:
                 value = self.finite(combine(value, *run), last) if run else value
                 run = []
                 self.check_power(value, right, op_node.right)  # point at the exponent
-                value = self.finite(value**right, op_node)
+                value = self.bounded(self.finite(value**right, op_node), op_node.right)
                 continue
             kind = sp.Add if op in (ast.Add, ast.Sub) else sp.Mul
             if run and kind is not combine:
@@ -333,7 +373,10 @@ class _Builder:
                 raise self.error("division by zero", op_node)
             combine, last = kind, op_node
             run.append(-right if op is ast.Sub else 1 / right if op is ast.Div else right)
-        return self.finite(combine(value, *run), last) if run else value
+        if not run:
+            return value
+        # past the limit at the last operand of the run: the factor that took it over
+        return self.bounded(self.finite(combine(value, *run), last), getattr(last, "right", last))
 
     def check_power(self, base: sp.Expr, exponent: sp.Expr, node: ast.AST) -> None:
         """Refuse powers before sympy computes them: 9**387420489 would take minutes and memory."""
@@ -361,6 +404,26 @@ class _Builder:
                 # acos(65) is complex: meaningless in mechanics, and sympy can spend minutes
                 # on expressions built from such constants (atan2(acos(65), 0)).
                 raise self.error("not a real number", node)
+        return value
+
+    def bounded(self, value: sp.Expr, node: ast.AST) -> sp.Expr:
+        """Refuse an expression whose degree or nesting of exponentials is past the limits: a
+        power of a power, or powers multiplied, can reach x**4096 with every exponent ≤ 64,
+        and sympy then spends minutes on it, or every double overflows."""
+        degree = _degree(value)
+        if degree > MAX_DEGREE:
+            raise self.error(
+                f"the powers here reach degree {degree:g}, over the limit of {MAX_DEGREE}: a "
+                "power of a power multiplies the exponents ((x**8)**8 is x**64), powers of one "
+                "base multiplied add them (x**40*x**40 is x**80)",
+                node,
+            )
+        if _exp_nesting(value) > MAX_EXP_NESTING:
+            raise self.error(
+                f"exponentials nested more than {MAX_EXP_NESTING} deep (exp of exp of exp, or "
+                "a power with a variable exponent inside one): no double can hold their values",
+                node,
+            )
         return value
 
     def name(self, node: ast.Name) -> sp.Expr:
@@ -406,7 +469,7 @@ class _Builder:
         if name == "atan2" and any(a.is_number and a.is_extended_real is False for a in args):
             # sympy's atan2(acos(65), 0) grinds for minutes deciding the sign of i*acosh(65).
             raise self.error("atan2() takes real arguments", node)
-        return self.finite(FUNCTIONS[name](*args), node)
+        return self.bounded(self.finite(FUNCTIONS[name](*args), node), node)
 
 
 def parse(text: str | int | float, names: Mapping[str, sp.Expr], *, field: str = "") -> sp.Expr:

@@ -247,3 +247,75 @@ def test_a_singular_start_of_the_coordinates_blames_that_initial_value():
     problem = one_problem(client.post("/api/v1/check/predict", json=body), 422)
     assert problem["field"] == "initial.theta"
     assert "theta = 0" in problem["message"]
+
+
+# --- 3. nested powers and exponentials: bounded in total, not only one exponent at a time ----
+
+
+def check(answer: str, quantity: str = "T", scene_id: str = "simple_pendulum"):
+    body = {"scene_id": scene_id, "quantity": quantity, "answer": answer}
+    return client.post("/api/v1/check", json=body)
+
+
+@pytest.mark.parametrize(
+    "answer, degree",
+    [
+        ("((theta)**64)**64", 64 * 64),
+        ("((theta_dot**2)**8)**8", 2 * 8 * 8),
+        ("((sin(theta)+cos(theta))**64)**64", 64 * 64),
+        ("(((theta+1)**4)**4)**8", 4 * 4 * 8),
+        ("theta**40*theta**40", 40 + 40),  # one base: sympy writes it theta**80
+        ("m*" * 70 + "m", 71),
+    ],
+)
+def test_powers_past_degree_64_in_total_are_a_422_on_answer(answer, degree):
+    problem = one_problem(check(answer), 422)
+    assert problem["field"] == "answer"
+    assert f"degree {degree}" in problem["message"] and "64" in problem["message"]
+
+
+@pytest.mark.parametrize(
+    "answer",
+    [
+        "(theta**64)**64**2",  # 64**2 is one exponent of 4096
+        "theta**(64*64)",
+        "theta_dot**(8**3)",
+    ],
+)
+def test_one_exponent_past_64_is_a_422_on_answer(answer):
+    problem = one_problem(check(answer), 422)
+    assert problem["field"] == "answer" and "exponent too large" in problem["message"]
+
+
+@pytest.mark.parametrize(
+    "answer",
+    ["exp(exp(exp(theta)))", "exp(exp(exp(exp(exp(exp(theta_dot))))))", "2**(2**(2**theta))"]
+    + ["cosh(sinh(exp(theta_dot)))", "exp(theta_dot**theta**theta)"],
+)
+def test_exponentials_nested_three_deep_are_a_422_on_answer(answer):
+    problem = one_problem(check(answer, "V"), 422)
+    assert problem["field"] == "answer"
+    assert "exponentials nested" in problem["message"]
+
+
+def test_predict_refuses_the_same_towers_on_answer():
+    for answer in ("((theta)**64)**64", "exp(exp(exp(theta)))"):
+        body = {"scene_id": "simple_pendulum", "quantity": "V", "answer": answer}
+        problem = one_problem(client.post("/api/v1/check/predict", json=body), 422)
+        assert problem["field"] == "answer"
+
+
+@pytest.mark.parametrize(
+    "answer, right",
+    [
+        ("1/2 m l^2 ((theta_dot)**2)", True),
+        ("1/2 m l^2 (theta_dot**2)**2", False),  # θ̇⁴: judged, not refused
+        ("1/2 m l^2 theta_dot^2 (sin(theta)**2 + cos(theta)**2)", True),
+        ("1/2 m l^2 theta_dot^2 ((sin(theta)**2 + cos(theta)**2)**4)**4", True),  # degree 32
+        ("1/2 m l^2 theta_dot^2 exp(exp(theta) - exp(theta))", True),  # exp nested twice
+    ],
+)
+def test_honest_powers_and_exponentials_are_still_judged(answer, right):
+    r = check(answer)
+    assert r.status_code == 200, r.text
+    assert r.json()["correct"] is right
