@@ -201,8 +201,11 @@ def _grammar_error(text: str) -> tuple[str, int] | None:
 
     Python reports the end of the input, or column 0, for an expression that stops too early
     (``theta +``); a walk over the tokens, alternating between "a term comes next" and "an
-    operator comes next", names the token that breaks the alternation instead. None when the
-    walk finds nothing (Python's column is used then).
+    operator comes next", names the token that breaks the alternation instead. The position is
+    where the student types the fix: just after an operator a term is missing after (``theta +``
+    points past the '+'), at a token that does not belong. The message is a plain sentence (no
+    "syntax error"): a student reads it. None when the walk finds nothing (Python's column is
+    used then).
     """
     want_term, calls, prev = True, [], None  # calls: is each open '(' a function call's?
     pos = 0
@@ -225,15 +228,15 @@ def _grammar_error(text: str) -> tuple[str, int] | None:
                 pass  # a sign
             elif kind == "close" and prev is not None and prev[0] == "open":
                 if not calls or not calls[-1]:
-                    return "syntax error: nothing between '(' and ')'", prev[2]
+                    return "nothing is between '(' and ')'", prev[2] + 1  # where it goes
                 calls.pop()
                 want_term = False
             elif kind == "op":
-                return f"syntax error: '{value}' needs a term before it", start
+                return f"'{value}' needs a term before it", start
             elif prev is None:
-                return f"syntax error: '{value}' cannot start an expression", start
+                return f"'{value}' cannot start an expression", start
             else:
-                return f"syntax error: a term is missing after '{prev[1]}'", prev[2]
+                return f"a term is missing after '{prev[1]}'", prev[2] + len(prev[1])
         elif kind == "op" or (kind == "comma" and calls and calls[-1]):
             want_term = True
         elif kind == "close":
@@ -244,20 +247,17 @@ def _grammar_error(text: str) -> tuple[str, int] | None:
             calls.append(True)
             want_term = True
         elif kind == "open":
-            return "syntax error: write '*' before '(' to multiply", start
+            return "write '*' before '(' to multiply", start
         elif kind == "comma":
-            return "syntax error: a comma may only separate a function's arguments", start
+            return "a comma may only separate a function's arguments", start
         else:
             return (
-                f"syntax error: an operator is missing before '{value}' (write '*' to multiply)",
+                f"an operator is missing before '{value}' (write '*' to multiply)",
                 start,
             )
         prev = (kind, value, start)
     if want_term and prev is not None:
-        return (
-            f"syntax error: the expression ends with '{prev[1]}', a term is missing after it",
-            prev[2],
-        )
+        return f"a term is missing after '{prev[1]}' at the end", prev[2] + len(prev[1])
     return None
 
 
@@ -268,7 +268,7 @@ def _tree(text: object, field: str) -> tuple[ast.expr, int]:
     except SyntaxError as exc:
         found = _grammar_error(clean)
         if found is None:  # Python's own column, when the token walk sees nothing wrong
-            message, col = "syntax error", max((exc.offset or 1) - 1, 0)
+            message, col = "this cannot be read as arithmetic here", max((exc.offset or 1) - 1, 0)
         else:
             message, col = found
         raise ExprError(message, field=field, position=offset + col) from None
@@ -339,8 +339,23 @@ class _Builder:
             return self.name(node)
         if isinstance(node, ast.Call):
             return self.call(node, depth)
+        if isinstance(node, ast.Tuple):
+            raise self.tuple_error(node)
         refusal = _REFUSALS.get(type(getattr(node, "op", None))) or _REFUSALS.get(type(node))
         raise self.error(refusal or f"{type(node).__name__} is not allowed", node)
+
+    def tuple_error(self, node: ast.Tuple) -> ExprError:
+        """``()`` is an empty pair of parentheses; ``m, l`` has a comma, pointed at."""
+        if not node.elts:
+            return ExprError(
+                "nothing is between '(' and ')'",
+                field=self.field,
+                position=self.at(node) + 1,  # where the missing term goes
+            )
+        first = node.elts[0]
+        after = getattr(first, "end_col_offset", None)
+        position = None if after is None else after + self.offset
+        return ExprError(_REFUSALS[ast.Tuple], field=self.field, position=position)
 
     def at(self, node: ast.AST) -> int:
         return node.col_offset + self.offset
@@ -449,9 +464,11 @@ class _Builder:
         name = node.func.id
         if name not in FUNCTIONS:
             if name in self.names or name in CONSTANTS:
-                raise self.error(
-                    f"function '{name}' is not allowed: '{name}' is a name; write '*' to multiply",
-                    node,
+                after = getattr(node.func, "end_col_offset", None)  # where the '*' goes
+                raise ExprError(
+                    f"'{name}' is a name, not a function: write '*' before '(' to multiply",
+                    field=self.field,
+                    position=None if after is None else after + self.offset,
                 )
             raise self.error(
                 f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})", node

@@ -36,11 +36,13 @@ def error_of(answer, quantity="T", scene="simple_pendulum", coordinate=None):
 @pytest.mark.parametrize(
     ("answer", "position", "says"),
     [
-        # t h e t a _ +  : the '+' with nothing after it is character 6 (0-based)
-        ("theta +", 6, "ends with '+'"),
+        # t h e t a _ +  : the '+' with nothing after it is character 6 (0-based); the term
+        # goes after it, at 7 (the end)
+        ("theta +", 7, "missing after '+' at the end"),
         # the student's notation is rewritten (^ -> **, spaces, θ̇ -> theta_dot) before parsing;
-        # the position still counts what was typed: "m l^2 θ̇^2 +" has its '+' at 11
-        ("m l^2 θ̇^2 +", 11, "ends with '+'"),
+        # the position still counts what was typed: "m l^2 θ̇^2 +" has its '+' at 11, the
+        # missing term's place at 12
+        ("m l^2 θ̇^2 +", 12, "missing after '+' at the end"),
         # '(' at 0 is never closed
         ("(theta + 1", 0, "never closed"),
         # ')' at 9 closes nothing
@@ -52,8 +54,8 @@ def error_of(answer, quantity="T", scene="simple_pendulum", coordinate=None):
         # '**' misuse: "m***2" is m ** *2: the lone '*' at 3 has no term before it
         ("m***2", 3, "'*' needs a term"),
         ("m ** ** 2", 5, "'**' needs a term"),
-        # "2*(m+)": the '+' at 4 has no term after it
-        ("2*(m+)", 4, "missing after '+'"),
+        # "2*(m+)": the '+' at 4 has no term after it: it goes at 5
+        ("2*(m+)", 5, "missing after '+'"),
         # '^^': the second caret at 2 (rewritten to '**') has nothing before it
         ("m^^2", 2, "needs a term"),
         # refused by the notation rewrite itself: a prime after a number, a stray character
@@ -72,18 +74,18 @@ def test_parse_errors_point_at_the_character_typed(answer, position, says):
 
 
 def test_an_equation_split_at_equals_keeps_positions():
-    # "theta'' + g/l sin(theta) = +": the right side's '+' is at 27
+    # "theta'' + g/l sin(theta) = +": the right side's '+' is at 27, its missing term at 28
     text = "theta'' + g/l sin(theta) = +"
     assert text.index("=") == 25
     error = error_of(text, "eom", coordinate="theta")
-    assert error.position == 27, error.message
+    assert error.position == 28, error.message
 
 
 def test_the_parser_alone_points_at_a_trailing_operator():
     """The whitelist parser itself (no student notation): Python says column 0 or the end."""
     with pytest.raises(ExprError) as info:
         parse("a + b *", {"a": 1, "b": 2}, field="f")
-    assert info.value.position == 6 and "ends with '*'" in info.value.message
+    assert info.value.position == 7 and "missing after '*' at the end" in info.value.message
     with pytest.raises(ExprError) as info:
         parse("a b", {"a": 1, "b": 2}, field="f")
     assert info.value.position == 2 and "operator is missing" in info.value.message
@@ -97,8 +99,9 @@ def test_api_parse_error_names_answer_and_place():
     assert r.status_code == 422
     detail = r.json()["detail"][0]
     assert detail["field"] == "answer"
-    # "m l^2 theta'^2 +": '+' is character 16 counting from 1
-    assert "at character 16" in detail["message"]
+    # "m l^2 theta'^2 +": '+' is character 16 counting from 1; the term goes at 17, the end
+    assert "at character 17" in detail["message"]
+    assert not detail["message"].startswith("syntax")
 
 
 # -- feedback is math, never code -------------------------------------------------------------

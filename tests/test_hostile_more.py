@@ -319,3 +319,43 @@ def test_honest_powers_and_exponentials_are_still_judged(answer, right):
     r = check(answer)
     assert r.status_code == 200, r.text
     assert r.json()["correct"] is right
+
+
+# --- 5. parse errors: a plain sentence, pointing where the fix is typed ----------------------
+
+
+@pytest.mark.parametrize(
+    "answer, at, says",
+    [
+        # the term missing after a trailing '+' goes after it: "theta +" has 7 characters
+        ("theta +", 7, "a term is missing after '+'"),
+        ("1/2 m l^2 theta'^2 +", 20, "a term is missing after '+'"),
+        ("theta + ", 8, "a term is missing after '+'"),  # at the end, past the space
+        ("m*(l+)", 5, "a term is missing after '+'"),  # before the ')', after the '+'
+        ("m * * l", 4, "'*' needs a term before it"),  # the second '*' is the one to fix
+        ("m*()", 3, "nothing is between '(' and ')'"),  # inside the parentheses
+        ("m*(l, g)", 4, "comma"),  # the comma itself
+        ("theta))", 5, "')' without a matching '('"),  # the first ')' closes nothing
+    ],
+)
+def test_a_parse_error_points_where_the_fix_goes_in_plain_words(answer, at, says):
+    problem = one_problem(check(answer), 422)
+    assert problem["field"] == "answer"
+    message = problem["message"]
+    assert says in message
+    assert not message.lower().startswith("syntax") and "syntax error" not in message
+    # the message shows the place, counting from 1, with the typed text around it
+    assert f"at character {at + 1}:" in message
+    shown = message.split(": ", 1)[1] if ": " in message else message
+    before = answer[max(0, at - 24) : at].lstrip()
+    assert f"{before}⟨here⟩" in shown, (before, shown)
+
+
+def test_the_parser_alone_points_past_a_trailing_operator():
+    from mechanics.expr import ExprError, parse
+
+    for text, at in (("a +", 3), ("a + b *", 7), ("(a -)", 4)):
+        with pytest.raises(ExprError) as info:
+            parse(text, {"a": 1, "b": 2}, field="f")
+        assert info.value.position == at, (text, info.value.position)
+        assert info.value.message.startswith("a term is missing after")
