@@ -198,7 +198,10 @@ def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: floa
             break
         steps += 1
         if steps >= MAX_STEPS or time.monotonic() > deadline:
-            run.why = "it needs too many steps (it is stiff or blowing up)"
+            run.why = (
+                f"it needs more than {MAX_STEPS} steps or {RUN_SECONDS:g} s (the motion is "
+                "very fast, stiff or blowing up)"
+            )
             break
     finite = np.all(np.isfinite(out[:k]), axis=1)
     k = int(np.argmin(finite)) if not finite.all() else k
@@ -221,6 +224,15 @@ def initial_state(
                 errors.append({"field": f"{where}.{name}", "message": f"unknown name '{name}'"})
             elif not math.isfinite(value):
                 errors.append({"field": f"{where}.{name}", "message": "must be a finite number"})
+            elif where == "initial" and abs(value) > BLOW_UP:
+                # a start past the blow-up line would be reported as a blow-up at once
+                errors.append(
+                    {
+                        "field": f"{where}.{name}",
+                        "message": f"must be at most {BLOW_UP:g} in size: a prediction stops "
+                        "any run whose |q| or |q̇| passes that",
+                    }
+                )
     if errors:
         raise SpecError(errors)
     values = {**spec.parameters, **parameters}
@@ -449,7 +461,7 @@ def predict(
         "parting_rule": rule,
         **energy,
         "blamed": blamed,
-        "summary": _summary(parted_at, student, energy, blamed),
+        "summary": _summary(parted_at, student, energy, blamed, true, t_end),
     }
 
 
@@ -473,9 +485,16 @@ def energy_change(
 
 
 def _summary(
-    parted_at: float | None, student: Run, energy: dict[str, Any], blamed: str | None
+    parted_at: float | None,
+    student: Run,
+    energy: dict[str, Any],
+    blamed: str | None,
+    true: Run | None = None,
+    t_end: float | None = None,
 ) -> str:
-    """One sentence a student reads first (math as $…$)."""
+    """One sentence a student reads first (math as $…$). When a run stopped before t_end
+    without blowing up (too many steps), the comparison covers only the time both reached,
+    and the sentence says so: "the same motion" over 0.45 s is not over 5 s."""
     parts = []
     if student.blew_up_at is not None:
         parts.append(
@@ -497,8 +516,18 @@ def _summary(
             f"measured with the true energy, your model's energy swings by up to {most:.0%} "
             f"of the true motion's largest kinetic energy ({energy['energy_scale']:.3g})"
         )
+    window = ""
+    if true is not None and t_end is not None and student.blew_up_at is None:
+        cut = [(r.reached, whose, r.why) for r, whose in ((true, "the true"), (student, "your"))]
+        reached, whose, why = min(cut, key=lambda c: c[0])
+        if reached < t_end * (1 - 1e-9):
+            window = (
+                f" Compared over the first {reached:.2f} s only, where {whose} motion's run "
+                f"stopped: {why or 'it was cut short'}."
+            )
     if not parts:
-        return "Your answer predicts the same motion as the derivation."
+        return f"Your answer predicts the same motion as the derivation.{window}"
     text = "; ".join(parts)
     text = text[0].upper() + text[1:]
-    return f"{text}. The cause: {blamed[0].lower() + blamed[1:]}" if blamed else f"{text}."
+    cause = f" The cause: {blamed[0].lower() + blamed[1:]}" if blamed else ""
+    return f"{text}.{window}{cause}"

@@ -359,3 +359,25 @@ def test_the_parser_alone_points_past_a_trailing_operator():
             parse(text, {"a": 1, "b": 2}, field="f")
         assert info.value.position == at, (text, info.value.position)
         assert info.value.message.startswith("a term is missing after")
+
+
+# --- found by playing the hostile user: predictions ------------------------------------------
+
+
+def test_a_start_past_the_blow_up_line_is_refused_not_called_a_blow_up():
+    """θ = 1e300 was 'your answer's motion blows up at t = 1e-06 s' for θ̈ = 0, which never
+    blows up: the start was already past the |q| < 1e6 line every run is held to."""
+    problem = one_problem(predict(initial={"theta": 1e300}), 422)
+    assert problem["field"] == "initial.theta"
+    assert "1e+06" in problem["message"]
+
+
+def test_a_comparison_cut_short_says_over_how_long():
+    """At θ̇ = 1e5 rad/s the true run needs more than its step cap: 'the same motion' holds only
+    over the time it reached, and the summary says so."""
+    r = predict(initial={"theta_dot": 1e5}, t_end=5)
+    assert r.status_code == 200, r.text
+    body = r.json()
+    reached = min(body["true"]["reached"], body["student"]["reached"])
+    assert reached < 5
+    assert f"first {reached:.2f} s only" in body["summary"], body["summary"]
