@@ -270,8 +270,7 @@ def work_precision(
         if len(t_eval) not in references:
             ref = _run(c, params, y0, t_eval, "dop853_c", clock, rtol=REF_TOL, atol=REF_TOL)
             if ref.status != "ok":
-                message = f"the reference run did not finish: {ref.message}"
-                raise SpecError([{"field": "t_end", "message": message}])
+                raise SpecError(reference_failed(c, params, y0, req, ref, clock))
             references[len(t_eval)] = ref.y[:, : 2 * c.n]
         return references[len(t_eval)]
 
@@ -379,6 +378,53 @@ def long_run(
         "h": h,
         "runs": runs,
     }
+
+
+def reference_failed(
+    c: CompiledScene,
+    params: list[float],
+    y0: np.ndarray,
+    req: PrecisionRequest,
+    ref: Trajectory,
+    clock: _Clock,
+) -> list[dict[str, str]]:
+    """The 422 of a reference run that did not finish, on the value to blame. A run that breaks
+    at once (g = 1e308: the motion leaves double precision in its first steps) is the values'
+    fault, not t_end's: each override is put back to the scene's own value in turn over the
+    first thousandth of t_end, and one without which the run gets through is named."""
+    message = f"the reference run did not finish: {ref.message}"
+    reached = ref.t_reached if math.isfinite(ref.t_reached) else (ref.t[-1] if len(ref.t) else 0)
+    if reached > 1e-3 * req.t_end or not (req.parameters or req.initial):
+        return [{"field": "t_end", "message": message}]
+    spec, n = c.derivation.model.spec, c.n
+    window = np.linspace(0.0, 1e-3 * req.t_end, 3)
+
+    def through(p: list[float], y: np.ndarray) -> bool:
+        return _run(c, p, y, window, "DOP853", clock, rtol=1e-6, atol=1e-6).status == "ok"
+
+    blamed = []
+    for name, value in req.parameters.items():
+        p = list(params)
+        p[c.parameters.index(name)] = spec.parameters[name]
+        if through(p, y0):
+            blamed.append(("parameters", name, value))
+    for name, value in req.initial.items():
+        y = np.array(y0, dtype=float)
+        q = name.removesuffix("_dot")
+        i = c.coordinates.index(q) + (n if name.endswith("_dot") else 0)
+        y[i] = spec.initial.get(name, 0.0)
+        if through(params, y):
+            blamed.append(("initial", name, value))
+    if not blamed:
+        return [{"field": "t_end", "message": message}]
+    return [
+        {
+            "field": f"{where}.{name}",
+            "message": f"with {name} = {value:g} the motion leaves double precision at once "
+            f"({message})",
+        }
+        for where, name, value in blamed
+    ]
 
 
 def precision_compiled(c: CompiledScene, req: PrecisionRequest, seconds: float) -> dict[str, Any]:

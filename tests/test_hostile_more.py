@@ -381,3 +381,15 @@ def test_a_comparison_cut_short_says_over_how_long():
     reached = min(body["true"]["reached"], body["student"]["reached"])
     assert reached < 5
     assert f"first {reached:.2f} s only" in body["summary"], body["summary"]
+
+
+# --- found by playing the hostile user: precision ---------------------------------------------
+
+
+def test_a_reference_run_broken_by_a_value_names_the_value_not_t_end():
+    """g = 1e308: the pendulum's q̈ = −g/l sin θ leaves double precision in the first steps; the
+    422 said field 't_end', which no t_end can fix."""
+    body = {"scene_id": "simple_pendulum", "methods": ["rk4"], "parameters": {"g": 1e308}}
+    problem = one_problem(client.post("/api/v1/precision", json=body), 422)
+    assert problem["field"] == "parameters.g"
+    assert "g = 1e+308" in problem["message"] and "double precision" in problem["message"]
