@@ -159,9 +159,12 @@ export class Stage {
     const shapes = sceneShapes(g, this.view, this.frame, {
       radius: font - 1, trail: g.is3D ? 3 : 1.5, scaleBar: true, font,
     });
-    const turn = this.placeable() ? "drag a body to place it, drag elsewhere to turn the view" : "drag to turn the view";
-    const note = g.is3D ? turn : this.follow ? "camera follows the motion" : "";
-    if (note) shapes.push({ t: "text", at: [10, 8 + font], text: note, color: "#868e96", size: font });
+    const turn = this.placeable() ? ["drag a body to place it,", "drag elsewhere to turn the view"] : ["drag to turn the view"];
+    const note = g.is3D ? turn : this.follow ? ["camera follows the motion"] : [];
+    // one line where it fits, else a line per phrase (a phone's narrow canvas)
+    ctx.font = `500 ${font}px system-ui, sans-serif`;
+    const lines = ctx.measureText(note.join(" ")).width <= this.cssW - 20 ? [note.join(" ")] : note;
+    lines.forEach((text, k) => shapes.push({ t: "text", at: [10, 8 + font + k * 1.3 * font], text, color: "#868e96", size: font }));
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
     const v = this.view; // the camera, for tests that check where things are drawn

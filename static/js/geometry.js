@@ -48,11 +48,52 @@ function massValue(mass, parameters) {
   return Number.isFinite(x) ? x : 1;
 }
 
+/**
+ * The positions to draw. A run shown at more frames than it was sampled at (live.js forDisplay:
+ * `sampled`, `stats.display_factor`) has its in-between points on the straight chord between two
+ * samples, so a trail drawn through them bends only at the samples, 30 times a second: kinks a
+ * fast bob shows plainly. Here the in-between points lie on a cubic through the samples (Hermite,
+ * each sample's tangent the central difference of its neighbours in time), so the trail and the
+ * motion are smooth (the ends' tangents from a parabola through three samples); the points at
+ * the samples are the measured ones.
+ */
+function smoothPositions(result) {
+  const base = result.sampled, factor = result.stats?.display_factor;
+  if (!base?.positions || !(factor > 1) || base.t.length < 3) return result.positions;
+  const t = base.t, n = t.length;
+  if ((n - 1) * factor + 1 !== result.t.length) return result.positions; // not forDisplay's shape
+  // the slope at a of the parabola through (a, b, c): the ends' tangents, as good as the middle's
+  const end = (v, a, b, c) => v[a] * (2 * t[a] - t[b] - t[c]) / ((t[a] - t[b]) * (t[a] - t[c]))
+    + v[b] * (t[a] - t[c]) / ((t[b] - t[a]) * (t[b] - t[c])) + v[c] * (t[a] - t[b]) / ((t[c] - t[a]) * (t[c] - t[b]));
+  const curve = (v) => {
+    const slope = (i) => (i === 0 ? end(v, 0, 1, 2) : i === n - 1 ? end(v, n - 1, n - 2, n - 3)
+      : (v[i + 1] - v[i - 1]) / (t[i + 1] - t[i - 1]));
+    const out = new Array(result.t.length);
+    let m0 = slope(0);
+    for (let i = 0; i < n - 1; i++) {
+      const h = t[i + 1] - t[i], m1 = slope(i + 1);
+      out[i * factor] = v[i];
+      for (let k = 1; k < factor; k++) {
+        const f = k / factor, f2 = f * f, f3 = f2 * f;
+        out[i * factor + k] = (2 * f3 - 3 * f2 + 1) * v[i] + (f3 - 2 * f2 + f) * h * m0
+          + (3 * f2 - 2 * f3) * v[i + 1] + (f3 - f2) * h * m1;
+      }
+      m0 = m1;
+    }
+    out[(n - 1) * factor] = v[n - 1];
+    return out;
+  };
+  const same = (v) => v.every((x) => x === v[0]); // a fixed point stays exactly where it is
+  return Object.fromEntries(Object.entries(base.positions).map(([name, p]) => [name,
+    same(p.x) && same(p.y) && same(p.z) ? result.positions[name]
+      : { x: curve(p.x), y: curve(p.y), z: curve(p.z) }]));
+}
+
 export class SceneGeometry {
   constructor(spec, result, parameters = spec.parameters || {}) {
     this.spec = spec;
     this.result = result;
-    this.P = result.positions;
+    this.P = smoothPositions(result);
     this.n = result.t.length;
     this.bodies = spec.bodies.filter((b) => this.P[b.name]);
     this.parameters = parameters;

@@ -249,7 +249,13 @@ export class BodyDrag {
     ctx.closePath();
     ctx.fill();
     ctx.font = "12px system-ui, sans-serif";
-    ctx.fillText("v (tip: where it is after 1 s)", x1 + 6, y1 - 6);
+    const label = "v (tip: where it is after 1 s)";
+    const w = ctx.measureText(label).width; // beside the tip, slid inside the canvas
+    const lx = Math.max(4, Math.min(x1 + 6, st.cssW - 4 - w)), ly = y1 < 24 ? y1 + 20 : y1 - 8;
+    ctx.fillStyle = "rgba(255,255,255,0.85)";
+    ctx.fillRect(lx - 2, ly - 12, w + 4, 16);
+    ctx.fillStyle = "#d9480f";
+    ctx.fillText(label, lx, ly);
     ctx.restore();
   }
 }
