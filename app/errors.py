@@ -165,8 +165,12 @@ def request_errors(errors: Iterable[dict[str, Any]], body: Any) -> list[dict[str
 
 def _relative(loc: list[Any], body: Any) -> tuple[list[Any], Any]:
     """The loc relative to the posted scene (or the request body), and the document it indexes."""
+    if loc[:1] in (["path"], ["query"]):
+        # a path or query parameter by its own name (`scene_id`, `format`), as the route's
+        # other errors about it (an unknown scene_id's 404) name it
+        return loc[1:], None
     if loc[:1] != ["body"]:
-        return loc, None  # a path or query parameter
+        return loc, None
     loc = loc[1:]
     if loc[:1] == ["scene"] and len(loc) > 1 and isinstance(body, dict):
         return loc[1:], body.get("scene")

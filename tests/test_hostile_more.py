@@ -393,3 +393,29 @@ def test_a_reference_run_broken_by_a_value_names_the_value_not_t_end():
     problem = one_problem(client.post("/api/v1/precision", json=body), 422)
     assert problem["field"] == "parameters.g"
     assert "g = 1e+308" in problem["message"] and "double precision" in problem["message"]
+
+
+# --- found by playing the hostile user: exports and path parameters --------------------------
+
+
+@pytest.mark.parametrize(
+    "query, field",
+    [
+        ("trajectory.csv?tol=0", "tol"),  # the page's key, not /simulate's rtol and atol
+        ("run.py?method=Radau&tol=1e-20", "tol"),
+        ("run.py?tol=1e-3&atol=5", "atol"),
+    ],
+)
+def test_a_get_exports_tolerance_is_refused_under_the_pages_key(query, field):
+    r = client.get(f"/api/v1/export/scenes/simple_pendulum/{query}")
+    problem = one_problem(r, 422)
+    assert problem["field"] == field and "must be in" in problem["message"]
+
+
+def test_path_parameters_are_named_as_themselves():
+    """A bad format or scene id in the URL is 'format' / 'scene_id', as an unknown scene's 404
+    names it (was 'path.format')."""
+    r = client.get("/api/v1/export/scenes/simple_pendulum/trajectory.xml")
+    assert one_problem(r, 422)["field"] == "format"
+    r = client.get("/api/v1/export/scenes/Simple_Pendulum/spec.toml")
+    assert one_problem(r, 422)["field"] == "scene_id"

@@ -31,7 +31,7 @@ from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns,
 from mechanics.export_share import ShareError, decode_state, encode_state, state_problems
 from mechanics.integrators import METHODS
 from mechanics.scenes import load_scene, scene_ids
-from mechanics.spec import IDENT, MAX_COORDINATES, MAX_PARAMETERS
+from mechanics.spec import IDENT, MAX_COORDINATES, MAX_PARAMETERS, SpecError
 
 #: One router for the exports under /api/v1/export and the share link /s/{token} (a page URL),
 #: so the app includes it once.
@@ -141,6 +141,19 @@ async def post_script(request: SimulateRequest, http: Request) -> Response:
     return _download(await _script(request, http), PYTHON, f"{_file_stem(request)}_run.py")
 
 
+def _in_page_terms(exc: SpecError, query: Any) -> SpecError:
+    """A GET export's refusal in the page query's names: its ``tol`` is /simulate's rtol and
+    atol at once, so a tolerance out of range is said once, on ``tol`` (on ``atol`` when the
+    query gives that key itself)."""
+    names = {"rtol": "tol", "atol": "atol" if "atol" in query else "tol"}
+    out: list[dict[str, str]] = []
+    for error in exc.errors:
+        error = {**error, "field": names.get(error["field"], error["field"])}
+        if not any(o["field"] == error["field"] for o in out):
+            out.append(error)
+    return SpecError(out)
+
+
 @router.get(
     API + "/scenes/{scene_id}/run.py",
     response_class=Response,
@@ -151,7 +164,11 @@ async def get_script(scene_id: SceneId, http: Request) -> Response:
     """`POST /api/v1/export/script` for a built-in scene, with the scene page's query string
     (parameter and initial values by name, `method`, `tol`, `dt`, `t_end`)."""
     request = _page_request(scene_id, http)
-    return _download(await _script(request, http), PYTHON, f"{scene_id}_run.py")
+    try:
+        script = await _script(request, http)
+    except SpecError as exc:
+        raise _in_page_terms(exc, http.query_params) from None
+    return _download(script, PYTHON, f"{scene_id}_run.py")
 
 
 async def _script(request: SimulateRequest, http: Request) -> str:
@@ -217,7 +234,10 @@ async def post_trajectory(
 )
 async def get_trajectory(scene_id: SceneId, format: TrajectoryFormat, http: Request) -> Response:
     """`POST /api/v1/export/trajectory` for a built-in scene, with the page's query string."""
-    return await _trajectory(_page_request(scene_id, http), http, format)
+    try:
+        return await _trajectory(_page_request(scene_id, http), http, format)
+    except SpecError as exc:
+        raise _in_page_terms(exc, http.query_params) from None
 
 
 async def _trajectory(request: SimulateRequest, http: Request, format: str) -> Response:
