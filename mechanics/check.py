@@ -98,8 +98,16 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
     j = None
     if quantity in PER_COORDINATE:
         if coordinate not in model.coordinate_names:
+            names = ", ".join(model.coordinate_names)
+            what = "missing" if coordinate is None else f"'{coordinate}' is not a coordinate"
             raise SpecError(
-                [{"field": "coordinate", "message": f"one of {', '.join(model.coordinate_names)}"}]
+                [
+                    {
+                        "field": "coordinate",
+                        "message": f"{what}: {quantity} is asked per coordinate; give one of "
+                        f"{names}",
+                    }
+                ]
             )
         j = model.coordinate_names.index(coordinate)
     expected = expected_quantity(d, quantity, j)
@@ -175,8 +183,11 @@ class _Judge:
         return {k: sp.Float(v, 30) for k, v in values.items()}
 
     def values(self, expr: sp.Expr, motion_only: bool = False) -> list[complex]:
+        return self._values_at(expr, self.motion_states if motion_only else self.states)
+
+    def _values_at(self, expr: sp.Expr, states: list[dict]) -> list[complex]:
         out = []
-        for s in self.motion_states if motion_only else self.states:
+        for s in states:
             try:
                 v = complex(expr.xreplace(s).evalf(25))
                 abs(v)  # a modulus past double precision (1e308 + 1e308 i) raises here
@@ -206,10 +217,21 @@ class _Judge:
             self._eom(verdict)
             return
         if self.same(self.given, self.expected):
+            note = self._symbolic_note(self.given - self.expected)
+            apart = (
+                self._apart_elsewhere(self.given - self.expected, constant=False) if note else ""
+            )
+            if apart:
+                fb.append(apart)
+                return
             verdict.correct = True
-            fb.append("Correct." + self._symbolic_note(self.given - self.expected))
+            fb.append("Correct." + note)
             return
         if q in ("V", "L") and self._constant(self.given - self.expected):
+            apart = self._apart_elsewhere(self.given - self.expected, constant=True)
+            if apart:
+                fb.append(apart)
+                return
             verdict.correct = True
             fb.append(
                 "Correct up to a constant: that only moves the datum of V, which changes "
@@ -217,6 +239,45 @@ class _Judge:
             )
             return
         self._diagnose(self.given, self.expected, fb)
+
+    def _apart_elsewhere(self, diff: sp.Expr, constant: bool) -> str:
+        """An equality (or a constant difference) sympy could not prove, tested again across the
+        coordinates' whole range: the judging states keep every coordinate in [0.2, 1.3], where
+        sin, cos and q are positive, so abs(cos θ)/cos θ or sqrt(θ²) would pass there and be
+        wrong at θ = −1 or θ = 2 (the pendulum's own start). A sentence naming a state where
+        they part, or "" when none does."""
+        if constant and tidy(diff, self.m).is_number:
+            return ""
+        rng = random.Random(1)
+        positive = set(self.m.spec.positive_coordinates)
+        wide = []
+        for state in self.motion_states if constant else self.states:
+            state = dict(state)
+            for name, q in zip(self.m.coordinate_names, self.m.q, strict=True):
+                state[q] = sp.Float(rng.uniform(0.2 if name in positive else -3.1, 3.1), 30)
+            wide.append(state)
+        values = self._values_at(diff, wide)
+        base = self._values_at(diff, self.motion_states[:1])[0] if constant else 0
+        for state, v in zip(wide, values, strict=True):
+            if cmath.isnan(v) or cmath.isnan(base):
+                continue  # a pole of either: no number to compare there
+            if abs(v - base) > TOLERANCE * max(1.0, abs(base), abs(self._size(state))):
+                where = ", ".join(
+                    f"{name} = {float(state[q]):.3g}"
+                    for name, q in zip(self.m.coordinate_names, self.m.q, strict=True)
+                )
+                what = "differs by a constant from" if constant else "equals"
+                return (
+                    f"Your answer {what} the derived result where the coordinates are between "
+                    f"0.2 and 1.3, but not at {where}: something in it (an abs(), a sign() or a "
+                    "sqrt(x**2)?) agrees only on part of the range."
+                )
+        return ""
+
+    def _size(self, state: dict) -> complex:
+        """The expected value at a state, the scale a difference there is measured against."""
+        (v,) = self._values_at(self.expected, [state])
+        return 0 if cmath.isnan(v) else v
 
     def _symbolic_note(self, diff: sp.Expr) -> str:
         if tidy(diff, self.m) == 0:

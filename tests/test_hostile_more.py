@@ -419,3 +419,45 @@ def test_path_parameters_are_named_as_themselves():
     assert one_problem(r, 422)["field"] == "format"
     r = client.get("/api/v1/export/scenes/Simple_Pendulum/spec.toml")
     assert one_problem(r, 422)["field"] == "scene_id"
+
+
+# --- found by playing the hostile user: /check with answers right on part of the range -------
+
+
+@pytest.mark.parametrize(
+    "quantity, answer",
+    [
+        # equal to ½ m l² θ̇² only where cos θ > 0 (resp. θ > 0): the judging states keep θ in
+        # [0.2, 1.3], and these were 'Correct.' though wrong at the pendulum's own θ = 2
+        ("T", "1/2 m l^2 theta_dot^2 * abs(cos(theta))/cos(theta)"),
+        ("T", "1/2 m l^2 theta_dot^2 * sign(theta)"),
+        ("V", "-m g l abs(cos(theta))"),
+        ("V", "m g l (1 - abs(cos(theta)))"),  # was 'correct up to a constant'
+    ],
+)
+def test_an_answer_right_on_only_part_of_the_range_is_not_called_correct(quantity, answer):
+    r = check(answer, quantity)
+    assert r.status_code == 200, r.text
+    body = r.json()
+    assert body["correct"] is False
+    assert "part of the range" in " ".join(body["feedback"])
+
+
+@pytest.mark.parametrize(
+    "quantity, answer",
+    [
+        ("T", "1/2 m l^2 sqrt(theta_dot^4)"),  # θ̇⁴ ≥ 0: right everywhere
+        ("V", "-m g l cos(abs(theta))"),  # cos is even
+        ("V", "-m g l cos(theta) + 5"),  # a datum
+    ],
+)
+def test_answers_right_everywhere_stay_correct(quantity, answer):
+    r = check(answer, quantity)
+    assert r.status_code == 200 and r.json()["correct"] is True, r.text
+
+
+def test_a_per_coordinate_check_without_its_coordinate_says_what_is_missing():
+    body = {"scene_id": "double_pendulum", "quantity": "Q", "answer": "0"}
+    problem = one_problem(client.post("/api/v1/check", json=body), 422)
+    assert problem["field"] == "coordinate"
+    assert "missing" in problem["message"] and "theta1, theta2" in problem["message"]
