@@ -224,6 +224,14 @@ def initial_state(
                 errors.append({"field": f"{where}.{name}", "message": f"unknown name '{name}'"})
             elif not math.isfinite(value):
                 errors.append({"field": f"{where}.{name}", "message": "must be a finite number"})
+            elif where == "parameters" and value < 0 and d.model.params[name].is_nonnegative:
+                # as /simulate refuses it: the derivation took the parameter as a magnitude
+                errors.append(
+                    {
+                        "field": f"{where}.{name}",
+                        "message": f"must be ≥ 0 (the scene takes {name} as a magnitude)",
+                    }
+                )
             elif where == "initial" and abs(value) > BLOW_UP:
                 # a start past the blow-up line would be reported as a blow-up at once
                 errors.append(
@@ -237,6 +245,13 @@ def initial_state(
         raise SpecError(errors)
     values = {**spec.parameters, **parameters}
     state = {**spec.initial, **initial}
+    for q in spec.positive_coordinates:  # as /simulate: the derivation took q > 0 (r = √r²)
+        if state.get(q, 0.0) <= 0:
+            errors.append(
+                {"field": f"initial.{q}", "message": f"must be > 0 ({q} is declared positive)"}
+            )
+    if errors:
+        raise SpecError(errors)
     y0 = [state.get(q, 0.0) for q in spec.coordinates]
     y0 += [state.get(f"{q}_dot", 0.0) for q in spec.coordinates]
     return [values[k] for k in spec.parameters], y0

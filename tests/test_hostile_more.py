@@ -461,3 +461,18 @@ def test_a_per_coordinate_check_without_its_coordinate_says_what_is_missing():
     problem = one_problem(client.post("/api/v1/check", json=body), 422)
     assert problem["field"] == "coordinate"
     assert "missing" in problem["message"] and "theta1, theta2" in problem["message"]
+
+
+def test_a_prediction_refuses_what_simulate_refuses():
+    """A negative spring constant, a radius ≤ 0: /simulate said no, /check/predict integrated
+    them (the derivation took k as a magnitude and r > 0, r = √r²)."""
+    cases = [
+        ("spring_mass_damper", {"parameters": {"k": -1.0}}, "parameters.k", "≥ 0"),
+        ("central_force", {"initial": {"r": -1.0}}, "initial.r", "> 0"),
+    ]
+    for scene_id, fields, field, says in cases:
+        body = {"scene_id": scene_id, "quantity": "V", "answer": "0", **fields}
+        problem = one_problem(client.post("/api/v1/check/predict", json=body), 422)
+        assert problem["field"] == field and says in problem["message"]
+        simulated = client.post("/api/v1/simulate", json={"scene_id": scene_id, **fields})
+        assert field in {p["field"] for p in simulated.json()["detail"]}
