@@ -161,16 +161,26 @@ export class Stage {
     });
     const turn = this.placeable() ? ["drag a body to place it,", "drag elsewhere to turn the view"] : ["drag to turn the view"];
     const note = g.is3D ? turn : this.follow ? ["camera follows the motion"] : [];
-    // one line where it fits, else a line per phrase (a phone's narrow canvas)
-    ctx.font = `500 ${font}px system-ui, sans-serif`;
-    const lines = ctx.measureText(note.join(" ")).width <= this.cssW - 20 ? [note.join(" ")] : note;
-    lines.forEach((text, k) => shapes.push({ t: "text", at: [10, 8 + font + k * 1.3 * font], text, color: "#868e96", size: font }));
+    this.#noteLines(note, font).forEach((text, k) => shapes.push({ t: "text", at: [10, 8 + font + k * 1.3 * font], text, color: "#868e96", size: font }));
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
     const v = this.view; // the camera, for tests that check where things are drawn
     canvas.dataset.camera = JSON.stringify({ w: v.w, h: v.h, scale: v.scale, center: v.center, yaw: v.yaw, pitch: v.pitch, camera: v.camera, is3D: v.is3D });
     canvas.dataset.pieces = [...new Set(shapes.map((s) => s.piece).filter(Boolean))].sort().join(" ");
     if (this.instruments) this.instruments.update(this.frame);
+  }
+
+  /** The canvas note in one line where it fits, else a line per phrase (a phone's narrow
+   * canvas). Measured once per text and size: measuring text every frame costs a drag its 60 fps. */
+  #noteLines(note, font) {
+    const key = `${this.cssW}|${font}|${note.join("|")}`;
+    if (this.noteKey !== key) {
+      this.ctx.font = `500 ${font}px system-ui, sans-serif`;
+      const one = note.join(" ");
+      this.noteKey = key;
+      this.noteCache = this.ctx.measureText(one).width <= this.cssW - 20 ? [one] : note;
+    }
+    return this.noteCache;
   }
 
   #drag(e) {

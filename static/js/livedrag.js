@@ -90,6 +90,7 @@ export class BodyDrag {
 
   #hover(e) {
     if (this.drag || !this.#usable()) return;
+    if (e.buttons) { this.#highlight(null); return; } // the camera is being turned
     this.#highlight(this.#pick(this.#local(e)));
   }
 
