@@ -48,6 +48,26 @@ export function writeQuery({ params, initial, settings, fixed, lecture }) {
   return q.toString();
 }
 
+/** A value as its number box shows it: 4 significant digits (a slider moves in steps of 1/500 of
+ * its range, so more is noise: 0.7853981633974483 reads 0.7854), never fewer than the integer
+ * part's digits (1234.5 stays 1235, not 1.235e3), and no trailing zeros. The exact value is what
+ * the page keeps and sends; the box's title carries it for anyone who wants every digit. */
+export function shownValue(value, digits = 4) {
+  const x = Number(value);
+  if (!Number.isFinite(x) || x === 0) return String(x);
+  const whole = Math.floor(Math.log10(Math.abs(x))) + 1; // digits before the point
+  const shown = Number(x.toPrecision(Math.min(21, Math.max(digits, whole))));
+  return Math.abs(shown) < 1e-6 ? shown.toExponential() : String(shown);
+}
+
+/** Put `value` in a number box rounded for reading; the exact value in its title and data-exact
+ * (the page sends the exact value it keeps, never the box's text). */
+function showNumber(number, value) {
+  number.value = shownValue(value);
+  number.dataset.exact = String(value);
+  number.title = number.value === String(value) ? "" : `exactly ${value}`;
+}
+
 /** Build the rows of sliders; `onChange(name, value)` fires on every move (the caller debounces,
  * or previews live), `onCommit(name, value)` when a value is settled: a slider let go, a number
  * entered. */
@@ -66,15 +86,17 @@ export function buildControls(box, rows, onChange, onCommit = () => {}) {
     const number = row.querySelector('input[type="number"]');
     Object.assign(slider, { min: lo, max: hi, step: (hi - lo) / 500 });
     slider.value = value;
-    number.value = value;
+    showNumber(number, value);
     slider.addEventListener("input", () => {
-      number.value = slider.value;
+      showNumber(number, Number(slider.value));
       onChange(name, Number(slider.value));
     });
     slider.addEventListener("change", () => onCommit(name, Number(slider.value)));
     number.addEventListener("change", () => {
       const v = Number(number.value);
       if (number.value === "" || !Number.isFinite(v)) return;
+      number.dataset.exact = String(v); // typed: exactly what the box says
+      number.title = "";
       if (v < Number(slider.min)) slider.min = v;
       if (v > Number(slider.max)) slider.max = v;
       slider.value = v;
@@ -89,7 +111,7 @@ export function buildControls(box, rows, onChange, onCommit = () => {}) {
 export function setControl(name, value) {
   const slider = document.getElementById(`s-${name}`);
   const number = document.getElementById(`n-${name}`);
-  if (number) number.value = value;
+  if (number) showNumber(number, value);
   if (slider) {
     if (value < Number(slider.min)) slider.min = value;
     if (value > Number(slider.max)) slider.max = value;
