@@ -110,7 +110,7 @@ function yourTurn(stepId, target, coordinates) {
         for (const part of [".echo", ".expected"]) box.querySelector(part).textContent = "";
         box.querySelector(".feedback").replaceChildren();
         offerPrediction(box.querySelector(".predict"), null);
-        showError(verdict, err.message);
+        showError(verdict, err.message, body.answer);
         result.dataset.checked = String(mine);
       }
     };
@@ -124,22 +124,67 @@ function yourTurn(stepId, target, coordinates) {
   });
 }
 
-/** A refusal from the parser, with the place it points at marked in the text as typed:
- * "answer: syntax error: … (at character 7: theta ⟨here⟩+)" shows `theta ▸+`. */
-function showError(verdict, message) {
-  verdict.className = "verdict bad";
-  const m = /^(.*) \(at character (\d+): (.*)⟨here⟩(.*)\)$/s.exec(message);
-  if (!m) {
-    verdict.textContent = inlineMath(message);
-    typeset([verdict]);
-    return;
+/**
+ * A refusal of /check read for a student: a plain sentence and the place it points at in the text
+ * as typed. The server says `answer: syntax error: the expression ends with '+', a term is missing
+ * after it (at character 20: …theta'^2 ⟨here⟩+)`: the field and "syntax error" are jargon, and
+ * for a missing term its position is the operator's while what is wrong comes after it. So:
+ * `{ sentence: "Can't read your answer: a term is missing after '+' at the end.", text, at }`
+ * with `text` the whole answer (when the server's excerpt is found in it at its position, else
+ * the excerpt) and `at` the index in `text` where the marker goes: after the operator for a
+ * missing term (whichever of the two places the server points at), else where it points.
+ * `at` is null when the message points nowhere.
+ */
+export function readRefusal(message, typed = "") {
+  const raw = String(message).replace(/^answer:\s*/, "");
+  const m = /^(.*) \(at character (\d+): (.*)⟨here⟩(.*)\)$/s.exec(raw);
+  const what = (m ? m[1] : raw).replace(/^syntax error:?\s*/i, "");
+  const say = (plain) => `Can't read your answer: ${plain || "something does not fit here"}${/[.!?]$/.test(plain) ? "" : "."}`;
+  if (!m) return { sentence: say(what), text: typed, at: null };
+  let [, , char, before, after] = m;
+  if (before.startsWith("…")) before = before.slice(1);
+  if (after.endsWith("…")) after = after.slice(0, -1);
+  let text = `${before}${after}`, at = before.length;
+  const index = Number(char) - 1;
+  // the excerpt was trimmed (strip) by the server: find it in the answer at its position
+  const lead = typed.slice(0, index);
+  if (typed && lead.trimEnd().endsWith(before.trim()) && typed.slice(index).trimStart().startsWith(after.trim())) {
+    text = typed;
+    at = index;
   }
-  const [, what, at, before, after] = m;
-  // the typed text stays text (never math, whatever it holds); the message's own math renders
-  const code = el("code", { className: "typed" }, before,
-    el("mark", { textContent: "▸", title: `character ${at}` }), after);
-  verdict.replaceChildren(el("span", { textContent: `${inlineMath(what)} at character ${at}: ` }), code);
-  typeset([verdict.firstChild]);
+  // a missing term: the marker goes after the operator it is missing after, not before it, and
+  // the sentence names the operator where it is (character n counts from 1, as the server does)
+  const atEnd = /^the expression ends with '(.+)', a term is missing after it$/s.exec(what);
+  const op = (/a term is missing after '(.+?)'/.exec(what) || atEnd || [])[1];
+  if (op) {
+    const rest = text.slice(at);
+    const skip = rest.length - rest.trimStart().length;
+    if (rest.trimStart().startsWith(op)) at += skip + op.length;
+    const where = text.slice(0, at).endsWith(op) ? ` at character ${at - op.length + 1 + (text === typed ? 0 : index - before.length)}` : "";
+    at = Math.max(0, Math.min(at, text.length));
+    const plain = atEnd ? `it ends with a '${op}'${where ? ` (${where.trim()})` : ""} and no term after it`
+      : `a term is missing after the '${op}'${where}`;
+    return { sentence: say(plain), text, at };
+  }
+  const plain = `${what || "something does not fit here"} (at character ${char})`;
+  return { sentence: say(plain), text, at: Math.max(0, Math.min(at, text.length)) };
+}
+
+/** A refusal from the parser: a plain sentence, then the answer as typed with a ▸ where the
+ * problem is (`theta +▸` for a term missing after the '+'). */
+function showError(verdict, message, typed) {
+  verdict.className = "verdict bad";
+  const { sentence, text, at } = readRefusal(message, typed);
+  const words = el("span", { className: "refusal", textContent: inlineMath(sentence) });
+  if (at === null) {
+    verdict.replaceChildren(words);
+  } else {
+    // the typed text stays text (never math, whatever it holds); the message's own math renders
+    const code = el("code", { className: "typed" }, text.slice(0, at),
+      el("mark", { textContent: "▸", title: `character ${at + 1}` }), text.slice(at));
+    verdict.replaceChildren(words, " ", code);
+  }
+  typeset([words]);
 }
 
 /** Quantities whose wrong answer is a model of its own that can be integrated (predict.js). */
