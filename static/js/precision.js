@@ -30,6 +30,11 @@ const STYLE = `
 .precision .table-scroll { overflow-x: auto; }
 .precision h3 { font-size: 1rem; margin: .8rem 0 .3rem; }
 .precision .error { color: #c92a2a; }
+.precision tr.has-left-out td { border-bottom: 0; }
+.precision tr.left-out td { text-align: left; font-size: .85rem; color: var(--muted, #5b6575); padding-top: 0; }
+.precision tr.left-out ul { margin: 0; padding-left: 1.2rem; }
+.precision table { width: 100%; max-width: 60rem; }
+@media (max-width: 600px) { .precision th, .precision td { padding: .2rem .25rem; } .precision table { font-size: .82rem; } }
 `;
 
 function el(tag, props = {}, ...children) {
@@ -47,14 +52,42 @@ export function logRange(a, b, n) {
 
 const num = (x, digits = 3) => (x === null || x === undefined ? "–" : Math.abs(x) >= 1e-2 && Math.abs(x) < 1e4 ? Number(x.toPrecision(digits)).toString() : x.toExponential(digits - 1));
 
+/**
+ * Why each point of a method is not in its fit, as lines for the table: the API gives every
+ * left-out point its reason (`excluded`); points with the same reason are named together
+ * ("h = 0.05, 0.02 s: not converging yet (…)"), and a point with no error to draw (a run that
+ * stopped, a state that blew up) says it is not on the plots either. With fewer than two points
+ * left there is no fitted order, and the last line says so.
+ */
+/** A step as a plain decimal (0.0119), a tolerance as a power of ten (1e-5, 3.16e-7). */
+const settingText = (x, fixed) => (fixed ? String(Number(x.toPrecision(3))) : Number(x.toPrecision(3)).toExponential());
+
+export function leftOutLines(m) {
+  const fixed = m.kind === "fixed";
+  const groups = new Map();
+  for (const p of m.points) {
+    if (!p.excluded) continue;
+    const reason = p.error === null || p.error === undefined || !(p.error > 0)
+      ? `${p.excluded}; not on the plots (no error to draw)` : p.excluded;
+    if (!groups.has(reason)) groups.set(reason, []);
+    groups.get(reason).push(settingText(p.setting, fixed));
+  }
+  const lines = [...groups].map(([reason, settings]) =>
+    `left out: ${fixed ? "h" : "tol"} = ${settings.join(", ")}${fixed ? " s" : ""} — ${reason}`);
+  if (lines.length && m.points_in_fit < 2) {
+    lines.push(`no fitted order: ${m.points_in_fit === 0 ? "no point is" : "only one point is"} left to fit a slope to (try smaller ${fixed ? "steps" : "tolerances"} or a shorter t_end)`);
+  }
+  return lines;
+}
+
 function logLayout(title, x, y, ink) {
   return {
     font: { color: ink }, // the page's text colour: lecture mode's dark theme too
     title: { text: title, font: { size: 14 }, x: 0.02, xanchor: "left" },
     margin: { l: 62, r: 14, t: 40, b: 52 },
-    legend: { orientation: "h", y: -0.3, font: { size: 11 } },
+    legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0, font: { size: 11 } }, // under the axis title (plots.js)
     paper_bgcolor: "rgba(0,0,0,0)", plot_bgcolor: "rgba(0,0,0,0)",
-    xaxis: { type: "log", title: { text: x }, exponentformat: "power" },
+    xaxis: { type: "log", title: { text: x }, exponentformat: "power", automargin: true },
     yaxis: { type: "log", title: { text: y }, exponentformat: "power" },
   };
 }
@@ -141,10 +174,11 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
   }
 
   function showTable(result) {
+    const heads = ["method", "order", "fitted order", "points in fit", "fitted against"];
     table.replaceChildren(
-      el("caption", { textContent: "Measured order: least-squares slope of log error against log h (fixed step), or minus the slope against log RHS evaluations (adaptive)." }),
-      el("tr", {}, ...["method", "order", "fitted order", "points in fit", "fitted against"].map((h) => el("th", { scope: "col", textContent: h }))),
-      ...result.methods.map((m) => {
+      el("caption", { textContent: "Measured order: least-squares slope of log error against log h (fixed step), or minus the slope against log RHS evaluations (adaptive). A point left out of a fit is named under its method, with the reason." }),
+      el("tr", {}, ...heads.map((h) => el("th", { scope: "col", textContent: h }))),
+      ...result.methods.flatMap((m) => {
         const row = el("tr", {},
           el("td", { textContent: m.label }),
           el("td", { textContent: String(m.order) }),
@@ -152,9 +186,14 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
           el("td", { textContent: `${m.points_in_fit} of ${m.points.length}` }),
           el("td", { textContent: m.fitted_against }));
         row.dataset.method = m.method;
-        const left = m.points.filter((p) => p.excluded).map((p) => `${num(p.setting)}: ${p.excluded}`);
-        if (left.length) row.title = `left out: ${left.join("; ")}`;
-        return row;
+        const lines = leftOutLines(m);
+        if (!lines.length) return [row];
+        row.className = "has-left-out";
+        const cell = el("td", { colSpan: heads.length },
+          el("ul", {}, ...lines.map((text) => el("li", { textContent: text }))));
+        const why = el("tr", { className: "left-out" }, cell);
+        why.dataset.leftOutOf = m.method; // not data-method: that names the rows of orders
+        return [row, why];
       }));
     if (!result.long_run) { longBox.replaceChildren(); return; }
     const lr = result.long_run;
