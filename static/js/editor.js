@@ -9,6 +9,7 @@ const $ = (id) => document.getElementById(id);
 const LINE = 20; // px, as in app.css (.code textarea line-height)
 let view = null;
 let marks = [];
+let shared = null; // the spec a share link brought, reloadable from the "Start from" list
 
 export async function mountEditor() {
   const query = new URLSearchParams(location.search);
@@ -21,7 +22,11 @@ export async function mountEditor() {
     e.stopPropagation(); // typing is not a lecture-mode shortcut
     if (e.key === "Enter" && (e.ctrlKey || e.metaKey)) { e.preventDefault(); derive(); }
   });
-  $("load-template").addEventListener("click", () => load($("template").value));
+  $("load-template").addEventListener("click", () => {
+    const id = $("template").value;
+    if (id === SHARED && shared) showSpec(shared);
+    else load(id);
+  });
   $("derive").addEventListener("click", derive);
   const token = query.get("share");
   if (token && (await openShared(token))) return;
@@ -52,10 +57,46 @@ async function openShared(token) {
   if (state.lecture_step != null) q.set("step", String(state.lecture_step));
   if (state.phase) q.set("phase", state.phase);
   history.replaceState(null, "", `${location.pathname}?${q}`);
-  $("spec").value = JSON.stringify(state.scene, null, 2);
-  numberLines();
-  await derive();
+  shared = state.scene;
+  showSpec(shared);
+  await Promise.all([derive(), showOrigin(shared)]);
   return true;
+}
+
+const SHARED = ""; // the value of the "shared spec" entry of the "Start from" list
+
+function showSpec(spec) {
+  $("spec").value = JSON.stringify(spec, null, 2);
+  numberLines();
+}
+
+/** The built-in scene a spec came from: the one with its title (a share link carries the spec,
+ * not where it started), or null. */
+export function originOf(spec, scenes) {
+  const title = spec && typeof spec.title === "string" ? spec.title.trim() : "";
+  const found = title && scenes.find((s) => s.title.trim() === title);
+  return found ? found.id : null;
+}
+
+/** After a share link: the "Start from" list names the scene the spec came from, or a
+ * "shared spec" entry (which Load brings back) when it came from none. */
+async function showOrigin(spec) {
+  const select = $("template");
+  let id = null;
+  try {
+    id = originOf(spec, await getJSON("/api/v1/scenes"));
+  } catch {
+    id = null; // the list cannot be read: say "shared spec" rather than a wrong scene
+  }
+  select.querySelector("option[data-shared]")?.remove();
+  const known = id !== null && [...select.options].some((o) => o.value === id);
+  if (!known) {
+    const entry = new Option("shared spec", SHARED, true, true);
+    entry.dataset.shared = "1";
+    select.prepend(entry);
+  }
+  select.value = known ? id : SHARED;
+  select.dataset.origin = known ? id : "shared";
 }
 
 async function load(id) {
