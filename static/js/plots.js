@@ -27,14 +27,16 @@ export function layout(title, x, y, lecture) {
   const grid = lecture ? "#333" : "#e9ecef";
   return {
     // a title is kept short enough for a plot a third of the page wide, and a second line (<br>)
-    // gets room (automargin) instead of being clipped; the legend sits below the x-axis title
+    // gets room (automargin) instead of being clipped. The legend sits at the figure's foot in
+    // container coordinates: plotly then adds its height (two rows on a phone) to the bottom
+    // margin under the axis title; placed below the plot area (paper y < 0) it covered the title.
     title: { text: title, font: { size: lecture ? 22 : 14 }, automargin: true, x: 0.02, xanchor: "left" },
     margin: { l: 62, r: 14, t: lecture ? 56 : 44, b: lecture ? 64 : 52 },
-    legend: { orientation: "h", yanchor: "top", y: -0.24, x: 0, font: { size: lecture ? 20 : 11 } },
+    legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0, font: { size: lecture ? 20 : 11 } },
     font: { size: lecture ? 20 : 12, color: ink },
     paper_bgcolor: "rgba(0,0,0,0)",
     plot_bgcolor: "rgba(0,0,0,0)",
-    xaxis: { title: { text: x }, gridcolor: grid, zerolinecolor: grid },
+    xaxis: { title: { text: x }, gridcolor: grid, zerolinecolor: grid, automargin: true },
     yaxis: { title: { text: y }, gridcolor: grid, zerolinecolor: grid, exponentformat: "power" },
   };
 }

@@ -68,7 +68,9 @@ export function showWork(run, { lecture = false } = {}) {
   const ink = lecture ? "#f1f3f5" : "#1d2430";
   const base = { margin: { l: 60, r: 12, t: lecture ? 60 : 48, b: lecture ? 64 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
     plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 20 : 12 },
-    legend: { orientation: "h", yanchor: "top", y: -0.24 } };
+    // the legend at the figure's foot (container coordinates): plotly then makes room for it
+    // under the axis title, which a legend placed below the plot area (paper y < 0) would cover
+    legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0 } };
   // titles of one short line: plotly clips a title longer than its plot, and a second line too
   const title = (text) => ({ text, font: { size: lecture ? 22 : 14 }, x: 0.02, xanchor: "left" });
   const top = () => base.margin;
@@ -97,7 +99,7 @@ export function showWork(run, { lecture = false } = {}) {
   const workTitle = driven ? "W of forces and drive (stacked), ΔT + ΔV"
     : traces.length > 1 ? "W of non-conservative forces (stacked), ΔT + ΔV" : "W<sup>NC</sup> and ΔT + ΔV";
   window.Plotly.react("plot-work", traces, { ...base, margin: top(workTitle), title: title(workTitle), annotations,
-    xaxis: { title: { text: "t (s)" } }, yaxis }, CONFIG);
+    xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis }, CONFIG);
   // A body on a string or rod has a tension (which a string cannot make negative); any other
   // constraint (a block on an incline, a bead on a hoop) a reaction of magnitude |R|.
   const forces = run.constraint_forces || {};
@@ -110,7 +112,7 @@ export function showWork(run, { lecture = false } = {}) {
     : "constraint forces |R| along the run";
   $("plot-constraint").dataset.tension = tension ? "1" : "0";
   window.Plotly.react("plot-constraint", ctraces, { ...base, margin: top(constraintTitle), title: title(constraintTitle),
-    xaxis: { title: { text: "t (s)" } }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
+    xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
 }
 
 export function watchWorkInputs(onChange) {
