@@ -112,6 +112,16 @@ export class Instruments {
     this.caption = el("p", {}, SMALL);
     box.append(this.svg, this.caption);
     this.box.append(box);
+    // The bars are drawn in the svg's own pixels (its viewBox as wide as it is shown), so their
+    // labels keep their size whether the panel sits beside the animation (a narrow column) or
+    // under it: drawn again when its width changes.
+    new ResizeObserver(() => {
+      const w = Math.round(this.svg.getBoundingClientRect().width);
+      if (this.result && w > 0 && Math.abs(w - (this.drawnWidth || 0)) > 1) {
+        this.#buildBars();
+        this.#updateBars(this.stage.frame);
+      }
+    }).observe(this.svg);
   }
 
   #buildBars() {
@@ -123,24 +133,32 @@ export class Instruments {
     let lo = 0, hi = 0;
     for (const [k] of shown) for (const v of e[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (hi - lo < 1e-12) hi = lo + 1;
-    const top = 14, bottom = 126, left = 52, width = 300 - left - 6;
+    // one viewBox unit per CSS pixel, scaled with the page's root font (lecture mode's 24 px)
+    const u = (parseFloat(getComputedStyle(document.documentElement).fontSize) || 16) / 16;
+    const shownWidth = Math.round(this.svg.getBoundingClientRect().width);
+    this.drawnWidth = shownWidth;
+    const W = Math.max(160, shownWidth || 300), H = Math.round(150 * u);
+    this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const small = 9.5 * u, label = 12 * u;
+    const top = small + 5 * u, bottom = H - label - 10 * u;
+    const left = Math.min(52 * u, W * 0.26), width = W - left - 6;
     const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
-    this.axis = { y, shown };
+    this.axis = { y, shown, small };
     const slot = width / Math.max(shown.length, 1);
     const parts = [];
     const line = (x1, y1, x2, y2, color, extra = "") =>
       `<line x1="${x1}" y1="${y1.toFixed(1)}" x2="${x2}" y2="${y2.toFixed(1)}" stroke="${color}"${extra}/>`;
     parts.push(line(left, top, left, bottom, "#ced4da"));
     for (const v of [hi, 0, lo]) {
-      if (v !== 0 && Math.abs(y(v) - y(0)) < 12) continue; // would sit on the 0 label
-      parts.push(`<text x="${left - 4}" y="${(y(v) + 3).toFixed(1)}" font-size="9" fill="#868e96" text-anchor="end">${fmtJ(v)}</text>`);
+      if (v !== 0 && Math.abs(y(v) - y(0)) < small + 3) continue; // would sit on the 0 label
+      parts.push(`<text x="${left - 4}" y="${(y(v) + small / 3).toFixed(1)}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(v)}</text>`);
     }
-    parts.push(line(left, y(0), 300 - 4, y(0), "#868e96"));
-    shown.forEach(([k, label, color], j) => {
+    parts.push(line(left, y(0), W - 4, y(0), "#868e96"));
+    shown.forEach(([k, name, color], j) => {
       const x = left + slot * j + slot * 0.2, w = slot * 0.6;
       parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
-      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="10" font-size="9" fill="#495057" text-anchor="middle"></text>`);
-      parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="142" font-size="11" fill="${color}" text-anchor="middle" font-style="italic">${label}</text>`);
+      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${small}" fill="#343a40" text-anchor="middle"></text>`);
+      parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="${(H - 6 * u).toFixed(1)}" font-size="${label}" fill="${color}" text-anchor="middle" font-style="italic">${name}</text>`);
     });
     this.svg.innerHTML = parts.join("");
     Object.assign(this.svg.dataset, { lo: String(lo), hi: String(hi) });
@@ -166,7 +184,7 @@ export class Instruments {
       rect.dataset.value = String(v);
       const label = this.labels[k];
       label.textContent = fmtJ(v);
-      label.setAttribute("y", String(Math.max(9, Math.min(a, b) - 3).toFixed(1)));
+      label.setAttribute("y", String(Math.max(this.axis.small, Math.min(a, b) - 3).toFixed(1)));
     }
   }
 
