@@ -209,7 +209,14 @@ def read_answer(
             return parse(text[start:end], names, field="answer")
         except ExprError as exc:
             at = None if exc.position is None else where[min(start + exc.position, len(text))]
-            raise _pointed(exc.message, answer, at) from None
+            message = exc.message
+            if exc.position is not None and "'**'" in message:
+                # the parser saw '**' where the student typed '^': name what was typed
+                k = start + exc.position
+                ops = [i for i in (k, k - 2) if 0 <= i and text[i : i + 2] == "**"]
+                if ops and answer[where[ops[0]]] == "^":
+                    message = message.replace("'**'", "'^'")
+            raise _pointed(message, answer, at) from None
 
     if "=" not in text:
         return read(0, len(text)), sp.S.Zero

@@ -89,7 +89,7 @@ _REFUSALS: dict[type, str] = {
     ast.BitXor: "'^' is not allowed; write powers as **",
     ast.Attribute: "attribute access is not allowed",
     ast.Tuple: "a comma may only separate a function's arguments",
-    ast.Starred: "'*' before an argument is not allowed",
+    ast.Starred: "'*' needs a term before it",
     ast.Lambda: "lambda is not allowed",
     ast.Subscript: "subscripts are not allowed",
     ast.Compare: "comparisons are not allowed",
@@ -473,6 +473,13 @@ class _Builder:
             raise self.error(
                 f"function '{name}' is not allowed (allowed: {', '.join(FUNCTIONS)})", node
             )
+        for keyword_ in node.keywords:
+            if keyword_.arg is None:  # sin(**x): a power with nothing before it, to a student
+                raise ExprError(
+                    "'**' needs a term before it",
+                    field=self.field,
+                    position=getattr(keyword_, "col_offset", node.col_offset) + self.offset,
+                )
         if node.keywords:
             raise self.error(f"{name}() takes no keyword arguments", node)
         for arg in node.args:

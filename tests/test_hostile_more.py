@@ -476,3 +476,21 @@ def test_a_prediction_refuses_what_simulate_refuses():
         assert problem["field"] == field and says in problem["message"]
         simulated = client.post("/api/v1/simulate", json={"scene_id": scene_id, **fields})
         assert field in {p["field"] for p in simulated.json()["detail"]}
+
+
+@pytest.mark.parametrize(
+    "answer, says, at",
+    [
+        # the student typed '^'; the message named the '**' it is rewritten to
+        ("+^", "'^' needs a term before it", 1),
+        ("theta'^", "a term is missing after '^'", 7),
+        # sin(^θ̇) read as sin(**θ̇), keyword arguments: 'sin() takes no keyword arguments'
+        ("sin(^theta_dot)", "'^' needs a term before it", 4),
+        ("sin(*theta)", "'*' needs a term before it", 4),
+    ],
+)
+def test_a_misplaced_power_is_named_as_typed(answer, says, at):
+    problem = one_problem(check(answer), 422)
+    assert problem["field"] == "answer"
+    assert says in problem["message"] and "keyword" not in problem["message"]
+    assert f"at character {at + 1}:" in problem["message"]

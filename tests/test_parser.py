@@ -297,7 +297,7 @@ def test_a_python_float_with_many_digits_stays_a_float():
         ("m\u00a0+ 1", ["character"]),
         ("m(g)", ["write '*'"]),
         ("(m*g)(1)", ["listed functions"]),
-        ("sin(**m)", ["keyword"]),
+        ("sin(**m)", ["needs a term before"]),
         ("1 +* 2", ["needs a term before"]),
         ("...", ["..."]),
         ("1e308*1e308", ["finite"]),
