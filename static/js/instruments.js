@@ -108,7 +108,7 @@ export class Instruments {
     this.svg.setAttribute("viewBox", "0 0 300 150");
     this.svg.setAttribute("role", "img");
     this.svg.setAttribute("aria-label", "energy bars");
-    this.svg.style.cssText = "width:100%;max-width:360px;height:auto;display:block;background:#fff;border-radius:4px";
+    this.svg.style.cssText = "width:100%;max-width:22.5rem;height:auto;display:block;background:#fff;border-radius:4px";
     this.caption = el("p", {}, SMALL);
     box.append(this.svg, this.caption);
     this.box.append(box);
@@ -145,6 +145,8 @@ export class Instruments {
     const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
     this.axis = { y, shown, small };
     const slot = width / Math.max(shown.length, 1);
+    // a value label ("-1.23e-3": up to 8 characters, ~0.6 em each) fits its bar's slot
+    const valueSize = Math.min(small, (0.96 * slot) / (0.6 * 8));
     const parts = [];
     const line = (x1, y1, x2, y2, color, extra = "") =>
       `<line x1="${x1}" y1="${y1.toFixed(1)}" x2="${x2}" y2="${y2.toFixed(1)}" stroke="${color}"${extra}/>`;
@@ -157,7 +159,7 @@ export class Instruments {
     shown.forEach(([k, name, color], j) => {
       const x = left + slot * j + slot * 0.2, w = slot * 0.6;
       parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
-      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${small}" fill="#343a40" text-anchor="middle"></text>`);
+      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${valueSize.toFixed(1)}" fill="#343a40" text-anchor="middle"></text>`);
       parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="${(H - 6 * u).toFixed(1)}" font-size="${label}" fill="${color}" text-anchor="middle" font-style="italic">${name}</text>`);
     });
     this.svg.innerHTML = parts.join("");
