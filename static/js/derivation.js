@@ -154,7 +154,8 @@ export function readRefusal(message, typed = "") {
   }
   // a missing term: the marker goes after the operator it is missing after, not before it, and
   // the sentence names the operator where it is (character n counts from 1, as the server does)
-  const atEnd = /^the expression ends with '(.+)', a term is missing after it$/s.exec(what);
+  const atEnd = /^the expression ends with '(.+)', a term is missing after it$/s.exec(what)
+    || /^a term is missing after '(.+)' at the end$/s.exec(what);
   const op = (/a term is missing after '(.+?)'/.exec(what) || atEnd || [])[1];
   if (op) {
     const rest = text.slice(at);

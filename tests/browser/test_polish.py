@@ -218,6 +218,14 @@ def test_parse_refusals_read_plainly(server, page):
             "answer: syntax error: a term is missing after '*' (at character 3: m ⟨here⟩* + l)",
             "m * + l",
         ),
+        (  # mechanics/expr.py's newer wording, pointing after the operator
+            "answer: a term is missing after '+' at the end (at character 10: 1/2 m l +⟨here⟩)",
+            "1/2 m l +",
+        ),
+        (
+            "answer: a term is missing after '^' (at character 4: m l^⟨here⟩ + 2)",
+            "m l^ + 2",
+        ),
         ("answer: ')' without a matching '(' (at character 6: theta⟨here⟩))", "theta))"),
         ("answer: empty expression", ""),
     ]
@@ -232,6 +240,8 @@ def test_parse_refusals_read_plainly(server, page):
         "1/2 m l +",
         "1/2 m l +",
         "m *",
+        "1/2 m l +",
+        "m l^",
         "theta",
         None,
     ]
@@ -239,7 +249,8 @@ def test_parse_refusals_read_plainly(server, page):
         assert g["sentence"].startswith("Can't read your answer: "), g
         assert "syntax error" not in g["sentence"], g
     assert "'+'" in got[0]["sentence"] and "character 9" in got[0]["sentence"]
-    assert got[0]["sentence"] == got[1]["sentence"]
+    assert got[0]["sentence"] == got[1]["sentence"] == got[3]["sentence"]
+    assert "'^'" in got[4]["sentence"] and "character 4" in got[4]["sentence"]
 
 
 # ------------------------------------------------------------------------- 1. precision table
