@@ -25,7 +25,7 @@ from mechanics.derive import Derivation
 from mechanics.expr import to_latex
 from mechanics.model import T as t
 from mechanics.spec import SpecError
-from mechanics.steps import tidy
+from mechanics.steps import partial, tidy
 
 QUANTITIES = ("T", "V", "L", "Q", "eom", "accel", "momentum")
 PER_COORDINATE = {"Q", "eom", "accel", "momentum"}
@@ -240,7 +240,29 @@ class _Judge:
             return
         self._diagnose(self.given, self.expected, fb)
 
-    def _apart_elsewhere(self, diff: sp.Expr, constant: bool) -> str:
+    def _multiple_of_own(self, given: sp.Expr, expected: sp.Expr) -> bool:
+        """Does ``given`` vanish wherever this coordinate's own equation does, whatever the
+        other accelerations are? Then it is that equation times a factor (cos θ · (θ̈ + …)),
+        not a mix of several coordinates' equations."""
+        qdd = self.m.qdd[self.j]
+        coefficient = partial(expected, qdd, self.m)
+        if coefficient == 0:
+            return False
+        own = -(expected - coefficient * qdd) / coefficient  # q̈_j from its own equation
+        values = self.values(given.xreplace({qdd: own}), motion_only=True)
+        scale = [abs(v) for v in self.values(given, motion_only=True)]
+        return all(
+            not cmath.isnan(v) and abs(v) <= 1e-7 * max(1.0, s)
+            for v, s in zip(values, scale, strict=True)
+        )
+
+    def _apart_elsewhere(
+        self,
+        diff: sp.Expr,
+        constant: bool = False,
+        motion_only: bool = False,
+        claim: str = "",
+    ) -> str:
         """An equality (or a constant difference) sympy could not prove, tested again across the
         coordinates' whole range: the judging states keep every coordinate in [0.2, 1.3], where
         sin, cos and q are positive, so abs(cos θ)/cos θ or sqrt(θ²) would pass there and be
@@ -251,7 +273,7 @@ class _Judge:
         rng = random.Random(1)
         positive = set(self.m.spec.positive_coordinates)
         wide = []
-        for state in self.motion_states if constant else self.states:
+        for state in self.motion_states if constant or motion_only else self.states:
             state = dict(state)
             for name, q in zip(self.m.coordinate_names, self.m.q, strict=True):
                 state[q] = sp.Float(rng.uniform(0.2 if name in positive else -3.1, 3.1), 30)
@@ -266,9 +288,13 @@ class _Judge:
                     f"{name} = {float(state[q]):.3g}"
                     for name, q in zip(self.m.coordinate_names, self.m.q, strict=True)
                 )
-                what = "differs by a constant from" if constant else "equals"
+                what = claim or (
+                    "differs by a constant from the derived result"
+                    if constant
+                    else "equals the derived result"
+                )
                 return (
-                    f"Your answer {what} the derived result where the coordinates are between "
+                    f"Your answer {what} where the coordinates are between "
                     f"0.2 and 1.3, but not at {where}: something in it (an abs(), a sign() or a "
                     "sqrt(x**2)?) agrees only on part of the range."
                 )
@@ -308,7 +334,14 @@ class _Judge:
             )
             self._diagnose(given, expected, fb)
             return
-        if self._ratio(given, expected, motion_only=True) not in (None, 0):
+        ratio = self._ratio(given, expected, motion_only=True)
+        if ratio not in (None, 0):
+            apart = self._apart_elsewhere(
+                given - ratio * expected, motion_only=True, claim="is the derived equation, scaled,"
+            )
+            if apart:
+                fb.append(apart)
+                return
             verdict.correct = True
             exact = self._ratio(given, expected) == 1
             fb.append(
@@ -327,6 +360,14 @@ class _Judge:
                 )
                 return
         solved = dict(zip(self.m.qdd, self.d.solved_accelerations, strict=True))
+        if self.same(given.xreplace(solved), sp.S.Zero) and self._multiple_of_own(given, expected):
+            fb.append(
+                "Your equation holds along the motion, but it is the derived equation for "
+                f"{inline(self.m.q[self.j])} multiplied by something that changes with the state, "
+                "not by a constant: where that factor is zero your equation says nothing. Scale "
+                "an equation of motion only by a non-zero constant."
+            )
+            return
         if self.same(given.xreplace(solved), sp.S.Zero):
             fb.append(
                 "Your equation holds along the motion, but it is not the equation for "

@@ -494,3 +494,38 @@ def test_a_misplaced_power_is_named_as_typed(answer, says, at):
     assert problem["field"] == "answer"
     assert says in problem["message"] and "keyword" not in problem["message"]
     assert f"at character {at + 1}:" in problem["message"]
+
+
+def eom(answer: str, scene_id: str = "simple_pendulum", coordinate: str = "theta"):
+    body = {"scene_id": scene_id, "quantity": "eom", "coordinate": coordinate, "answer": answer}
+    return client.post("/api/v1/check", json=body)
+
+
+def test_an_equation_of_motion_right_on_part_of_the_range_is_not_correct():
+    """θ̈ + g/l |sin θ| = 0 was 'Correct: a non-zero multiple' (sin θ > 0 where it is judged)."""
+    body = eom("theta'' + g/l abs(sin(theta)) = 0").json()
+    assert body["correct"] is False
+    assert "part of the range" in body["feedback"][0]
+
+
+@pytest.mark.parametrize("factor", ["cos(theta)", "abs(cos(theta))", "theta_dot"])
+def test_an_equation_times_a_state_dependent_factor_is_named_so(factor):
+    """(θ̈ + g/l sin θ)·cos θ = 0 holds along the motion; it was said to 'mix in the equations
+    of the other coordinates', of a scene that has one coordinate."""
+    body = eom(f"(theta'' + g/l sin(theta))*{factor} = 0").json()
+    assert body["correct"] is False
+    (line,) = body["feedback"]
+    assert "changes with the state" in line and "other coordinates" not in line
+
+
+def test_a_mix_of_two_coordinates_equations_is_still_called_a_mix():
+    """The double pendulum's θ₁ equation plus its θ₂ equation: a mix, not a multiple."""
+    from mechanics.check import expected_quantity
+    from mechanics.expr import to_plain
+    from mechanics.jobs import derivation_of
+
+    d = derivation_of("double_pendulum", None)
+    mixed = expected_quantity(d, "eom", 0) + expected_quantity(d, "eom", 1)
+    body = eom(f"{to_plain(mixed)} = 0", "double_pendulum", "theta1").json()
+    assert body["correct"] is False
+    assert "other coordinates" in " ".join(body["feedback"])
