@@ -13,6 +13,7 @@ import { View } from "./view.js";
 
 const ASPECT = 0.66; // height / width, for 3-D scenes and tall planar ones
 const PAD = { "2d": 34, "3d": 18 };
+const KEEP_MARGIN = 12; // px: a run kept in a dragged view keeps its bodies (radius ~11) on the canvas
 const stages = new Set(); // every stage on the page: the ones showing the same spec share a scale
 
 export class Stage {
@@ -132,7 +133,7 @@ export class Stage {
       this.canvas.dataset.scale = view.scale.toPrecision(6);
       return true;
     }
-    if (!force && !view.contains(g.extent())) return false;
+    if (!force && !view.contains(g.extent(), KEEP_MARGIN)) return false;
     if (view.w !== this.cssW || view.h !== this.cssH) { // a new layout changed the canvas' shape
       if (view.w !== this.cssW) return false; // the page was resized meanwhile: fitted anew
       this.aspect = view.h / view.w;

@@ -34,11 +34,12 @@ export class View {
     return this;
   }
 
-  /** Whether every point is drawn inside the canvas (a 3-D view: as the camera looks now). */
-  contains(points) {
+  /** Whether every point is drawn inside the canvas, `margin` pixels from its edges (a 3-D
+   * view: as the camera looks now). */
+  contains(points, margin = 0) {
     return points.every((p) => {
       const [x, y] = this.project(p);
-      return x >= 0 && x <= this.w && y >= 0 && y <= this.h;
+      return x >= margin && x <= this.w - margin && y >= margin && y <= this.h - margin;
     });
   }
 
