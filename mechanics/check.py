@@ -586,11 +586,31 @@ class _Judge:
         dims[t] = (0, 0, 1)
         return dims if len(dims) >= len(m.params) + 3 * len(m.q) + 1 else {}
 
+    def _quantity_dimension(self, dims: dict[sp.Expr, units.Dim]) -> units.Dim | None:
+        """The units of the quantity asked for when its derived value is 0: an energy for T, V
+        and L; energy per unit of q_j for Q_j (a torque for an angle), energy·s per unit of q_j
+        for p_j; q_j per s² for q̈_j."""
+        energy = units.dimension(sp.expand(self.d.work.T), dims)
+        j = self.j or 0
+        if self.quantity == "accel":
+            return dims.get(self.m.qdd[j])
+        if energy is None:
+            return None
+        per = {"Q": self.m.q[j], "momentum": self.m.qd[j]}.get(self.quantity)
+        if per is None:
+            return energy if self.quantity in ("T", "V", "L") else None
+        base = dims[per]
+        return (energy[0] - base[0], energy[1] - base[1], energy[2] - base[2])
+
     def _units(self, given: sp.Expr) -> list[str]:
         dims = self._dimensions()
         if not dims:
             return []
-        want = units.dimension(sp.expand(self.reference), dims)
+        reference = sp.expand(self.reference)
+        if reference == 0:  # "0" has every unit: the quantity's own, from T (Q_θ of a pendulum)
+            want = self._quantity_dimension(dims)
+        else:
+            want = units.dimension(reference, dims)
         if want is None:
             return []
         what = {

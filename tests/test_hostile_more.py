@@ -529,3 +529,14 @@ def test_a_mix_of_two_coordinates_equations_is_still_called_a_mix():
     body = eom(f"{to_plain(mixed)} = 0", "double_pendulum", "theta1").json()
     assert body["correct"] is False
     assert "other coordinates" in " ".join(body["feedback"])
+
+
+def test_units_of_a_quantity_whose_derived_value_is_zero_are_the_quantitys():
+    """The pendulum's Q_θ is 0 (gravity is in V): −m g l sin θ, a torque, was told it 'has units
+    kg·m²/s², not dimensionless: it cannot belong here'. A Q_θ of an angle is a torque (N·m =
+    kg·m²/s²); a mass is not."""
+    body = {"scene_id": "simple_pendulum", "quantity": "Q", "coordinate": "theta"}
+    torque = client.post("/api/v1/check", json={**body, "answer": "-m g l sin(theta)"}).json()
+    assert not any("units" in line for line in torque["feedback"]), torque["feedback"]
+    mass = client.post("/api/v1/check", json={**body, "answer": "m"}).json()
+    assert any("units kg, not kg·m²/s²" in line for line in mass["feedback"]), mass["feedback"]
