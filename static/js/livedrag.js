@@ -131,8 +131,8 @@ export class BodyDrag {
     // gives the starting pose a velocity.
     const y = velocity ? start : this.#drawnState(start);
     this.drag = {
-      body, velocity, at, view: st.view, y, p: live.paramVector(sv.params), moved: false,
-      depth: st.view.project(st.geom.at(body, st.frame))[2],
+      body, velocity, at, press: at, view: st.view, y, p: live.paramVector(sv.params), moved: false,
+      seen: st.view.project(st.geom.at(body, st.frame)), // where the body was taken
       positive: (sv.spec.positive_coordinates || []).map((q) => live.meta.coordinates.indexOf(q)).filter((j) => j >= 0),
     };
     const move = (m) => {
@@ -158,27 +158,28 @@ export class BodyDrag {
     this.canvas.addEventListener("pointercancel", up);
   }
 
+  /** Where the velocity arrow's tip is on the screen: the start's place moved as far as the
+   * pointer moved since the press (the body may have been taken while it swung elsewhere). */
+  #tip(d, from) {
+    return [from[0] + d.at[0] - d.press[0], from[1] + d.at[1] - d.press[1]];
+  }
+
   /** The state the pointer asks for, into the controls and the preview. */
   #apply() {
     const d = this.drag;
     const live = this.sv.live;
     const here = live.places(d.y, d.p)[d.body];
-    if (d.view.is3D) {
-      if (d.velocity) {
-        const target = d.view.unproject(d.at[0], d.at[1], d.view.project(here)[2]);
-        const v = [0, 1, 2].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS);
-        d.y = velocityOnScreen(live, d.body, d.view, v, d.y, d.p);
-      } else {
-        d.y = placeOnScreen(live, d.body, d.view, d.at, d.depth, d.y, d.p, { positive: d.positive });
-        for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
-      }
-    } else if (d.velocity) {
-      const target = unproject(d.view, d.at[0], d.at[1], here[2]);
-      const v = [0, 1].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS).concat(0);
-      d.y = live.velocityFor(d.body, v, d.y, d.p);
-    } else {
-      const target = unproject(d.view, d.at[0], d.at[1], here[2]);
-      d.y = live.reach(d.body, target, d.y, d.p);
+    if (d.velocity) {
+      const from = d.view.project(here);
+      const [tx, ty] = this.#tip(d, from);
+      const target = d.view.is3D ? d.view.unproject(tx, ty, from[2]) : unproject(d.view, tx, ty, here[2]);
+      const v = [0, 1, 2].map((k) => (target[k] - here[k]) / VELOCITY_SECONDS);
+      if (d.view.is3D) d.y = velocityOnScreen(live, d.body, d.view, v, d.y, d.p);
+      else d.y = live.velocityFor(d.body, [v[0], v[1], 0], d.y, d.p);
+    } else { // the body follows the pointer, as far from it as where it was taken
+      const to = [d.seen[0] + d.at[0] - d.press[0], d.seen[1] + d.at[1] - d.press[1]];
+      if (d.view.is3D) d.y = placeOnScreen(live, d.body, d.view, to, d.seen[2], d.y, d.p, { positive: d.positive });
+      else d.y = live.reach(d.body, unproject(d.view, to[0], to[1], here[2]), d.y, d.p);
       for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
     }
     const values = {};
@@ -232,7 +233,7 @@ export class BodyDrag {
     if (!d || !d.velocity) return;
     const from = st.view.project(st.geom.at(d.body, 0));
     const ctx = st.ctx;
-    const [x0, y0] = from, [x1, y1] = d.at;
+    const [x0, y0] = from, [x1, y1] = this.#tip(d, from);
     const len = Math.hypot(x1 - x0, y1 - y0);
     if (len < 2) return;
     const ux = (x1 - x0) / len, uy = (y1 - y0) / len;

@@ -410,3 +410,19 @@ def test_a_3d_drag_keeps_sixty_frames_a_second(server, page):
     print(f"3-D drag: frame gaps median {median:.1f} ms, 90th percentile {p90:.1f} ms")
     assert median < 40
     assert page.errors == []
+
+
+def test_a_body_taken_off_centre_keeps_its_distance_from_the_pointer(server, page):
+    """Pressed 12 px right of the bob's centre and moved by (40, −30) px: the bob moves by the
+    same (no jump of its centre to the pointer), by the spec's formula and the camera."""
+    p = page.page
+    _ready(page, server, "spherical_pendulum")
+    _paused_at_start(p)
+    cam = _camera(p)
+    bob = _screen(p)["bob"]
+    press = (bob[0] + 12, bob[1])
+    Pointer(p).drag(press, (press[0] + 40, press[1] - 30))
+    q = _query(p)
+    x, y, _ = _project(cam, _bob(q["theta"], q["phi"]))
+    assert (x, y) == pytest.approx((bob[0] + 40, bob[1] - 30), abs=0.5)
+    assert page.errors == []
