@@ -330,6 +330,23 @@ def test_energy_bars_beside_the_animation_on_a_wide_window_only(server, page, si
         page.settle()
 
 
+@pytest.mark.parametrize("width,height", [(1280, 720), (1024, 768), (1920, 1080)])
+def test_lecture_modes_animation_stays_beside_what_is_read(server, page, sized, width, height):
+    """Lecture mode keeps the animation's column in view (sticky); it has a column of its own
+    for the page's whole height, so scrolled down to the plots it sits beside them, not on them."""
+    sized(width, height)
+    p = page.page
+    p.goto(f"{server}/scenes/spring_mass_damper?lecture=1")
+    wait_ready(page)
+    for panel in (".panel.plots", ".panel.work", ".col-side"):
+        p.eval_on_selector(panel, "n => n.scrollIntoView()")
+        p.wait_for_timeout(200)
+        main, other = rect(p, ".col-main"), rect(p, panel)
+        assert main["right"] <= other["left"], (panel, main, other)
+        assert main["bottom"] > 0 and main["top"] < height, "the animation is still in view"
+    assert_no_overflow(p, f"lecture at {width}×{height}")
+
+
 def test_compare_mode_puts_the_instruments_back_under_the_canvases(server, page, sized):
     sized(1400, 900)
     p = page.page
