@@ -540,3 +540,17 @@ def test_units_of_a_quantity_whose_derived_value_is_zero_are_the_quantitys():
     assert not any("units" in line for line in torque["feedback"]), torque["feedback"]
     mass = client.post("/api/v1/check", json={**body, "answer": "m"}).json()
     assert any("units kg, not kg·m²/s²" in line for line in mass["feedback"]), mass["feedback"]
+
+
+def test_a_lagrangian_with_abs_of_a_velocity_is_predicted_not_a_500():
+    """L = ½|θ̇|³ + …: Lagrange's equations hold DiracDelta(θ̇) (d/dθ̇ of sign θ̇), which the
+    integrator's math module does not know: a NameError, a 500. It is 0 away from θ̇ = 0."""
+    body = {"scene_id": "simple_pendulum", "quantity": "T", "t_end": 1}
+    body["answer"] = "1/2 m l^2 theta_dot^2 abs(theta_dot)"
+    # |θ̇|³ has no inertia at θ̇ = 0: refused as an answer that cannot start there
+    problem = one_problem(client.post("/api/v1/check/predict", json=body), 422)
+    assert problem["field"] == "answer" and "no motion from the initial state" in problem["message"]
+    # started moving, it runs: m l² |θ̇| θ̈ ... is a motion to draw
+    r = client.post("/api/v1/check/predict", json={**body, "initial": {"theta_dot": 1.0}})
+    assert r.status_code == 200, r.text
+    assert r.json()["student"]["reached"] > 0
