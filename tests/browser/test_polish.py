@@ -281,6 +281,12 @@ def test_every_point_left_out_of_a_fit_says_why(server, page):
             assert setting in text and pt["excluded"] in text, (m["method"], setting, text)
         if m["points_in_fit"] < 2:
             assert "no fitted order" in text
+    # its three log-log plots' legends are clear of their titles, tick labels and data
+    p.eval_on_selector("#precision-plot-energy", "n => n.scrollIntoView()")
+    p.wait_for_timeout(300)
+    found = p.evaluate(OVERLAPS)
+    for plot in ("time", "evals", "energy"):
+        assert found[f"precision-plot-{plot}"] == {"bad": [], "legend": True}, found
     # the orders table still has one row per method (what test_precision_page reads)
     assert p.locator("#precision-orders tr[data-method]").count() == len(result["methods"])
 
