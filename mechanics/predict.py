@@ -58,6 +58,7 @@ PART_COORDINATE = 0.05
 
 _SINGULAR = "its accelerations are not determined there (their coefficients vanish)"
 _INFINITE = "its accelerations are not finite"
+_DOMAIN = "it leaves the domain of a function (a root of a negative, …)"
 
 
 class _Stop(Exception):
@@ -150,7 +151,9 @@ def _rhs(fn: Any, n: int, params: list[float]) -> Any:
         except ZeroDivisionError:
             raise _Stop("it divides by zero") from None
         except ValueError:
-            raise _Stop("it leaves the domain of a function (a root of a negative, …)") from None
+            raise _Stop(_DOMAIN) from None
+        if any(isinstance(v, complex) for v in values):  # Python's (−1)**0.25 is complex
+            raise _Stop(_DOMAIN)
         if n == 1:  # the common case, without numpy's linear algebra per call
             a, b = values
             if not (math.isfinite(a) and math.isfinite(b)) or abs(a) <= 1e-300:

@@ -554,3 +554,13 @@ def test_a_lagrangian_with_abs_of_a_velocity_is_predicted_not_a_500():
     r = client.post("/api/v1/check/predict", json={**body, "initial": {"theta_dot": 1.0}})
     assert r.status_code == 200, r.text
     assert r.json()["student"]["reached"] > 0
+
+
+def test_a_fractional_power_of_a_negative_velocity_stops_the_run_not_the_server():
+    """x_dot**0.25 at x_dot < 0 is complex in Python's arithmetic: float() of it raised a
+    TypeError, a 500. The run stops there, saying it left the function's domain."""
+    body = {"scene_id": "cart_pendulum", "quantity": "Q", "coordinate": "theta", "t_end": 2}
+    r = client.post("/api/v1/check/predict", json={**body, "answer": "x_dot**0.25"})
+    assert r.status_code == 200, r.text
+    student = r.json()["student"]
+    assert student["blew_up_at"] is not None and "domain" in student["stopped_because"]
