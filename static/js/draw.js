@@ -13,6 +13,7 @@ import { View } from "./view.js";
 
 const ASPECT = 0.66; // height / width, for 3-D scenes and tall planar ones
 const PAD = { "2d": 34, "3d": 18 };
+const FOLLOWED_PX = 60; // the least size (px) of a body a following camera shows
 const KEEP_MARGIN = 12; // px: a run kept in a dragged view keeps its bodies (radius ~11) on the canvas
 const stages = new Set(); // every stage on the page: the ones showing the same spec share a scale
 
@@ -114,7 +115,10 @@ export class Stage {
         this.follow = true;
         const size = Math.max(...peers.map((s) => s.geom.bodySize()));
         const readable = size > 0 ? (Math.min(w, h) - 2 * pad) / (4 * size) : early.scale;
-        this.view.scale = Math.max(all.scale, Math.min(early.scale, readable));
+        // the first second in view, but on a narrow canvas (instruments beside it) never at the
+        // cost of the body itself: at least FOLLOWED_PX across, as long as 4 of it still fit
+        const legible = size > 0 ? Math.min(readable, FOLLOWED_PX / size) : 0;
+        this.view.scale = Math.max(all.scale, Math.min(early.scale, readable), legible);
       }
     }
     this.canvas.dataset.scale = this.view.scale.toPrecision(6);

@@ -410,16 +410,25 @@ export class SceneGeometry {
     }
     this.tracks.push({ body: name, origin: p0, dir, lo: Math.min(...s), hi: Math.max(...s) });
     if (body.kind === "rigid_body" && body.frame && this.result.frames[body.frame]) {
-      // Rolling: the turn angle follows the distance travelled, s = R * angle.
-      const F = this.result.frames[body.frame];
-      const ang = [];
-      for (const i of idx) {
-        let a = Math.atan2(F[i][1], F[i][0]);
-        if (ang.length) a += 2 * Math.PI * Math.round((ang[ang.length - 1] - a) / (2 * Math.PI));
-        ang.push(a);
+      // Rolling: the turn angle follows the distance travelled, s = R * angle. A turn between two
+      // samples is only known modulo a full turn, so a wheel that speeds up past half a turn a
+      // sample (a disk 5 s down a slope, 30 samples/s) would look slower, i.e. bigger: the
+      // radius is read over the stretch from the start where each sample turns < a quarter turn.
+      // Read from the measured samples (a run drawn between them has its frames interpolated
+      // along the shorter arc, which would hide the aliasing).
+      const run = this.result.sampled?.frames?.[body.frame] ? this.result.sampled : this.result;
+      const F = run.frames[body.frame], P = run.positions[name];
+      const angle = (i) => Math.atan2(F[i][1], F[i][0]);
+      const place = (i) => [P.x[i], P.y[i], P.z[i]];
+      let turned = 0, travelled = 0;
+      for (let i = 1; i < run.t.length; i++) {
+        let step = angle(i) - angle(i - 1);
+        step -= 2 * Math.PI * Math.round(step / (2 * Math.PI));
+        if (Math.abs(step) > Math.PI / 2) break;
+        turned += step;
+        travelled += dot(sub(place(i), place(i - 1)), dir);
       }
-      const turned = ang[ang.length - 1] - ang[0];
-      if (Math.abs(turned) > 1e-6) this.wheels.set(name, Math.abs((s[s.length - 1] - s[0]) / turned));
+      if (Math.abs(turned) > 1e-6) this.wheels.set(name, Math.abs(travelled / turned));
     }
     return true;
   }
