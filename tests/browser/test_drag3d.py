@@ -426,3 +426,27 @@ def test_a_body_taken_off_centre_keeps_its_distance_from_the_pointer(server, pag
     x, y, _ = _project(cam, _bob(q["theta"], q["phi"]))
     assert (x, y) == pytest.approx((bob[0] + 40, bob[1] - 30), abs=0.5)
     assert page.errors == []
+
+
+def test_a_fast_rolling_disk_is_drawn_at_its_own_radius(server, page):
+    """The disk rolls 10 s down the slope, ω = (2/3) g sin α t / R ≈ 10.5 t rad/s: past ~9 s it
+    turns more than half a turn between two of the server's 30 samples a second, which read
+    modulo a full turn looks like less. The wheel drawn is the spec's R = 0.3 m all the same."""
+    p = page.page
+    p.goto(f"{server}/")
+    radius = p.evaluate(
+        """async () => {
+          const { SceneGeometry } = await import('/static/js/geometry.js');
+          const { forDisplay } = await import('/static/js/live.js');
+          const spec = (await (await fetch('/api/v1/scenes/rolling_disk')).json()).spec;
+          const run = await (await fetch('/api/v1/simulate', { method: 'POST',
+            headers: { 'content-type': 'application/json' },
+            body: JSON.stringify({ scene_id: 'rolling_disk', t_end: 10, fps: 30 }) })).json();
+          const last = run.q.x[run.q.x.length - 1];
+          const g = new SceneGeometry(spec, forDisplay(run, 2));
+          return { r: g.wheels.get('disk'), turns: last / 0.3 / (2 * Math.PI) };
+        }"""
+    )
+    print("wheel radius drawn", radius["r"], "over", radius["turns"], "turns")
+    assert radius["turns"] > 80  # ~85: fast enough to alias at the end
+    assert radius["r"] == pytest.approx(0.3, rel=1e-6)
