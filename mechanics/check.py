@@ -218,6 +218,9 @@ class _Judge:
             return
         if self.same(self.given, self.expected):
             note = self._symbolic_note(self.given - self.expected)
+            if note and not self._same_to_precision(self.given, self.expected):
+                self._diagnose(self.given, self.expected, fb)
+                return
             apart = (
                 self._apart_elsewhere(self.given - self.expected, constant=False) if note else ""
             )
@@ -239,6 +242,24 @@ class _Judge:
             )
             return
         self._diagnose(self.given, self.expected, fb)
+
+    def _same_to_precision(self, given: sp.Expr, expected: sp.Expr) -> bool:
+        """An equality sympy could not prove, held to the precision of the evaluation (25
+        digits) relative to the size of the terms, not to TOLERANCE with a floor of 1: that
+        floor calls 1e-10·cos φ equal to a Q of 0, and in SI units (G = 6.7e-11) whole terms
+        are that small."""
+        terms = [*sp.Add.make_args(given), *sp.Add.make_args(expected)][: 2 * MAX_TERMS]
+        sizes = [0.0] * len(self.states)
+        for term in terms:
+            for i, v in enumerate(self.values(term)):
+                if not cmath.isnan(v):
+                    sizes[i] = max(sizes[i], abs(v))
+        for x, y, size in zip(self.values(given), self.values(expected), sizes, strict=True):
+            if cmath.isnan(x) or cmath.isnan(y):
+                continue
+            if abs(x - y) > 1e-15 * size:
+                return False
+        return True
 
     def _multiple_of_own(self, given: sp.Expr, expected: sp.Expr) -> bool:
         """Does ``given`` vanish wherever this coordinate's own equation does, whatever the
@@ -407,6 +428,11 @@ class _Judge:
         ratio = self._ratio(given, expected)
         if ratio == -1:
             fb.append("Sign error: your answer is the negative of the correct one.")
+        elif ratio == 1:  # a factor that rounds to 1 at 10 digits, yet is not exactly 1
+            fb.append(
+                "Every term is almost, but not exactly, what it should be (a factor that differs "
+                "from 1 only past the ninth digit): a number rounded or typed with a slip?"
+            )
         elif ratio is not None and ratio != 0:
             fb.append(
                 f"Off by a factor of {inline(ratio)}: every term is {inline(ratio)} times what it "
@@ -552,7 +578,7 @@ class _Judge:
             for b in params[i + 1 :]:
                 if dims and dims.get(a) != dims.get(b):
                     continue
-                if (given.has(a) or given.has(b)) and self.same(
+                if (given.has(a) or given.has(b)) and self._slip(
                     given.xreplace({a: b, b: a}), expected
                 ):
                     fb.append(
@@ -563,9 +589,14 @@ class _Judge:
             swapped = given.xreplace({qd: q}).xreplace({q: qd}) if given.has(qd) else None
             if swapped is None:
                 swapped = given.xreplace({q: qd})
-            if self.same(swapped, expected):
+            if swapped != given and self._slip(swapped, expected):
                 fb.append(f"You mixed up {inline(q)} and {inline(qd)} somewhere.")
         return fb
+
+    def _slip(self, changed: sp.Expr, expected: sp.Expr) -> bool:
+        """Is the answer with a slip undone the derived one, to the evaluation's precision (a
+        tolerance with a floor of 1 would undo a 'slip' in 1e-10·cos θ against a Q of 0)?"""
+        return self.same(changed, expected) and self._same_to_precision(changed, expected)
 
     def _dimensions(self) -> dict[sp.Expr, units.Dim]:
         m = self.m

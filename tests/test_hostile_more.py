@@ -564,3 +564,21 @@ def test_a_fractional_power_of_a_negative_velocity_stops_the_run_not_the_server(
     assert r.status_code == 200, r.text
     student = r.json()["student"]
     assert student["blew_up_at"] is not None and "domain" in student["stopped_because"]
+
+
+def test_a_tiny_wrong_term_is_not_correct_within_a_tolerance_of_one():
+    """The pendulum's Q_θ is 0; 1e-10·cos θ was 'Correct' (|difference| under 1e-9 with a floor
+    of 1), and 'You mixed up θ and θ̇' (1e-10·cos θ̇ is as near 0). In SI units whole terms are
+    that small (G = 6.7e-11)."""
+    body = {"scene_id": "simple_pendulum", "quantity": "Q", "coordinate": "theta"}
+    answer = client.post("/api/v1/check", json={**body, "answer": "1e-10*cos(theta)"}).json()
+    assert answer["correct"] is False
+    assert not any("mixed up" in line for line in answer["feedback"]), answer["feedback"]
+    assert any("Extra term" in line for line in answer["feedback"])
+
+
+def test_a_factor_that_rounds_to_one_is_not_called_a_factor_of_one():
+    answer = check("1/2 m l^2 theta_dot^2 * (1 + 1e-12)").json()
+    assert answer["correct"] is False
+    assert not any("factor of $1$" in line for line in answer["feedback"]), answer["feedback"]
+    assert "almost, but not exactly" in answer["feedback"][0]
