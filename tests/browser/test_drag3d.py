@@ -323,11 +323,13 @@ def test_a_bead_pulled_off_its_hoop_stops_at_the_hoops_nearest_point(server, pag
     assert page.errors == []
 
 
-def test_a_shift_drag_in_3d_sets_the_velocity_drawn_on_the_screen(server, page):
+@pytest.mark.parametrize("how", ["shift", "toggle"])
+def test_a_velocity_drag_in_3d_sets_the_velocity_drawn_on_the_screen(server, page, how):
     """The arrow from the bob to the pointer is its velocity in the plane of the screen (its tip
     where the bob is after 1 s): v = (the pointer's point on that plane − the bob) / 1 s. The
     rates set must give the bob that velocity on the screen: J q̇ along the screen's right and
-    up equals v's, with J = ∂r/∂(θ, φ) of r = l (sin θ cos φ, −cos θ, −sin θ sin φ)."""
+    up equals v's, with J = ∂r/∂(θ, φ) of r = l (sin θ cos φ, −cos θ, −sin θ sin φ). A drag
+    sets the velocity with Shift held, or after the "drag sets: velocity" toggle."""
     p = page.page
     _ready(page, server, "spherical_pendulum")
     _paused_at_start(p)
@@ -338,9 +340,16 @@ def test_a_shift_drag_in_3d_sets_the_velocity_drawn_on_the_screen(server, page):
     here = _bob(theta, phi, length)
     depth = _project(cam, here)[2]
     dx, dy = 50.0, -30.0
-    p.keyboard.down("Shift")
+    if how == "toggle":
+        p.click("#drag-mode")
+        assert p.inner_text("#drag-mode") == "drag sets: velocity"
+    else:
+        p.keyboard.down("Shift")
     Pointer(p).drag(bob, (bob[0] + dx, bob[1] + dy), steps=3)
-    p.keyboard.up("Shift")
+    if how == "toggle":
+        p.click("#drag-mode")  # back to position, for the tests after this one
+    else:
+        p.keyboard.up("Shift")
     tip = _unproject(cam, bob[0] + dx, bob[1] + dy, depth)
     v = [tip[k] - here[k] for k in range(3)]
     q = _query(p)
