@@ -582,3 +582,18 @@ def test_a_factor_that_rounds_to_one_is_not_called_a_factor_of_one():
     assert answer["correct"] is False
     assert not any("factor of $1$" in line for line in answer["feedback"]), answer["feedback"]
     assert "almost, but not exactly" in answer["feedback"][0]
+
+
+@pytest.mark.parametrize(
+    "state, field",
+    [
+        ({"scene_id": "simple_pendulum", "scene": {"title": "x"}}, "token.scene"),
+        ({}, "token.scene_id"),
+    ],
+)
+def test_a_token_with_both_or_neither_scene_names_which(state, field):
+    """Both scene_id and scene, or neither: the error was on 'token' alone."""
+    if "scene" in state:
+        state = {**state, "scene": load_scene("simple_pendulum")}
+    problem = one_problem(client.get(f"/s/{token_of(state)}", follow_redirects=False), 422)
+    assert problem["field"] == field and "scene" in problem["message"]

@@ -446,13 +446,7 @@ def _decoded(token: str) -> ShareState:
     except ShareError as exc:
         raise HTTPException(422, [{"field": "token", "message": str(exc)}]) from None
     except ValidationError as exc:
-        problems = [
-            {
-                "field": ".".join(["token", *(str(p) for p in e["loc"])]),
-                "message": e["msg"],
-            }
-            for e in exc.errors()
-        ]
+        problems = [{"field": _token_field(e), "message": e["msg"]} for e in exc.errors()]
         raise HTTPException(422, problems) from None
     # a hand-made token may name a scene or values the scene does not have: said here, not by
     # the page it would open
@@ -462,6 +456,13 @@ def _decoded(token: str) -> ShareState:
             422, [{"field": f"token.{p['field']}", "message": p["message"]} for p in problems]
         )
     return state
+
+
+def _token_field(error: Any) -> str:
+    """``token.<path>`` of a schema error in a token's state; a model-level error (scene_id and
+    scene both, or neither) has no path, and its context names the field."""
+    path = [str(p) for p in error["loc"]] or [(error.get("ctx") or {}).get("field") or ""]
+    return ".".join(["token", *path]).rstrip(".")
 
 
 def page_query(state: ShareState) -> str:
