@@ -597,3 +597,8 @@ def test_a_token_with_both_or_neither_scene_names_which(state, field):
         state = {**state, "scene": load_scene("simple_pendulum")}
     problem = one_problem(client.get(f"/s/{token_of(state)}", follow_redirects=False), 422)
     assert problem["field"] == field and "scene" in problem["message"]
+
+
+def test_if_none_match_star_is_a_304_for_a_live_module():
+    r = client.get("/api/v1/scenes/simple_pendulum/live.js", headers={"if-none-match": "*"})
+    assert r.status_code == 304 and r.headers["etag"]

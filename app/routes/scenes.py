@@ -215,6 +215,6 @@ def _cached(request: Request, body: bytes, etag: str, media_type: str, policy: s
     seen = [
         t.strip().removeprefix("W/") for t in request.headers.get("if-none-match", "").split(",")
     ]
-    if tag in seen:
+    if tag in seen or "*" in seen:  # '*' matches any current version (RFC 9110 13.1.2)
         return Response(status_code=304, headers=headers)
     return Response(body, media_type=media_type, headers=headers)
