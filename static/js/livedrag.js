@@ -253,7 +253,9 @@ export class BodyDrag {
     ctx.font = "12px system-ui, sans-serif";
     const label = "v (tip: where it is after 1 s)";
     const w = ctx.measureText(label).width; // beside the tip, slid inside the canvas
-    const lx = Math.max(4, Math.min(x1 + 6, st.cssW - 4 - w)), ly = y1 < 24 ? y1 + 20 : y1 - 8;
+    // past the tip, away from the shaft: below it for an arrow pointing down, else above
+    const below = (y1 > y0 && y1 + 20 < st.cssH) || y1 < 24;
+    const lx = Math.max(4, Math.min(x1 + 6, st.cssW - 4 - w)), ly = below ? y1 + 20 : y1 - 8;
     ctx.fillStyle = "rgba(255,255,255,0.85)";
     ctx.fillRect(lx - 2, ly - 12, w + 4, 16);
     ctx.fillStyle = "#d9480f";
