@@ -312,8 +312,10 @@ def _exp_nesting(expr: sp.Basic) -> int:
 class _Builder:
     """Turns a checked syntax tree into sympy, bottom-up, refusing anything off the whitelist."""
 
-    def __init__(self, names: Mapping[str, sp.Expr], field: str, offset: int) -> None:
-        self.names, self.field, self.offset = names, field, offset
+    def __init__(
+        self, names: Mapping[str, sp.Expr], field: str, offset: int, smooth: bool = False
+    ) -> None:
+        self.names, self.field, self.offset, self.smooth = names, field, offset, smooth
 
     def error(self, message: str, node: ast.AST | None = None) -> ExprError:
         col = getattr(node, "col_offset", None)
@@ -490,18 +492,40 @@ class _Builder:
             plural = "s" if arity > 1 else ""
             raise self.error(f"{name}() takes {arity} argument{plural}, not {len(node.args)}", node)
         args = [self.build(arg, depth + 1) for arg in node.args]
+        if self.smooth and name in _KINKED and any(a.has(AppliedUndef) for a in args):
+            raise self.error(
+                f"{name}() of a coordinate has no derivative where its argument is 0, and this "
+                "expression is differentiated in time (a position or an angle): write it for "
+                "the side the motion stays on",
+                node,
+            )
         if name == "atan2" and any(a.is_number and a.is_extended_real is False for a in args):
             # sympy's atan2(acos(65), 0) grinds for minutes deciding the sign of i*acosh(65).
             raise self.error("atan2() takes real arguments", node)
         return self.bounded(self.finite(FUNCTIONS[name](*args), node), node)
 
 
-def parse(text: str | int | float, names: Mapping[str, sp.Expr], *, field: str = "") -> sp.Expr:
-    """The only way user text becomes sympy: every node is checked against the whitelist."""
+#: Functions with a kink or a jump: a force may hold them (friction's sign(ṡ)), an expression
+#: that is differentiated in time may not hold them of a coordinate (see `parse`'s smooth).
+_KINKED = frozenset({"abs", "sign"})
+
+
+def parse(
+    text: str | int | float,
+    names: Mapping[str, sp.Expr],
+    *,
+    field: str = "",
+    smooth: bool = False,
+) -> sp.Expr:
+    """The only way user text becomes sympy: every node is checked against the whitelist.
+
+    ``smooth``: the expression is differentiated in time (a position, a frame's angle), so
+    abs() and sign() of a coordinate are refused: their derivatives stay unevaluated in sympy
+    and no later step can put numbers into them."""
     if isinstance(text, int | float) and not isinstance(text, bool):
         return _number(text, field)
     tree, offset = _tree(text, field)
-    result = _Builder(names, field, offset).build(tree)
+    result = _Builder(names, field, offset, smooth).build(tree)
     if result.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise ExprError("not a finite number", field=field)
     return result

@@ -602,3 +602,25 @@ def test_a_token_with_both_or_neither_scene_names_which(state, field):
 def test_if_none_match_star_is_a_304_for_a_live_module():
     r = client.get("/api/v1/scenes/simple_pendulum/live.js", headers={"if-none-match": "*"})
     assert r.status_code == 304 and r.headers["etag"]
+
+
+def test_the_parser_can_refuse_kinks_of_a_coordinate_where_it_is_differentiated():
+    """abs() or sign() of a coordinate in a posted position is a 500 on every route (its time
+    derivative stays unevaluated and cannot take numbers); parse(..., smooth=True) refuses it
+    naming the field, for mechanics/model.py to use on positions and angles. A force keeps
+    them (friction's sign(ṡ)), and so does an answer."""
+    import sympy as sp
+
+    from mechanics.expr import ExprError, parse
+
+    t = sp.Symbol("t")
+    names = {"theta": sp.Function("theta")(t), "l": sp.Symbol("l")}
+    for text in ("l*abs(sin(theta))", "l*sign(theta)"):
+        with pytest.raises(ExprError) as info:
+            parse(text, names, field="bodies[0].position[0]", smooth=True)
+        assert info.value.field == "bodies[0].position[0]"
+        assert "no derivative" in info.value.message and info.value.position is not None
+        assert parse(text, names, field="forces[0]").has(sp.Abs, sp.sign)
+    assert parse("abs(l)*sin(theta)", names, smooth=True) == abs(names["l"]) * sp.sin(
+        names["theta"]
+    )
