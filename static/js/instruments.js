@@ -137,31 +137,59 @@ export class Instruments {
     const u = (parseFloat(getComputedStyle(document.documentElement).fontSize) || 16) / 16;
     const shownWidth = Math.round(this.svg.getBoundingClientRect().width);
     this.drawnWidth = shownWidth;
-    const W = Math.max(160, shownWidth || 300), H = Math.round(150 * u);
-    this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const W = Math.max(160, shownWidth || 300);
     const small = 9.5 * u, label = 12 * u;
-    const top = small + 5 * u, bottom = H - label - 10 * u;
-    const left = Math.min(52 * u, W * 0.26), width = W - left - 6;
-    const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
-    this.axis = { y, shown, small };
-    const slot = width / Math.max(shown.length, 1);
-    // a value label ("-1.23e-3": up to 8 characters, ~0.6 em each) fits its bar's slot
-    const valueSize = Math.min(small, (0.96 * slot) / (0.6 * 8));
     const parts = [];
-    const line = (x1, y1, x2, y2, color, extra = "") =>
-      `<line x1="${x1}" y1="${y1.toFixed(1)}" x2="${x2}" y2="${y2.toFixed(1)}" stroke="${color}"${extra}/>`;
-    parts.push(line(left, top, left, bottom, "#ced4da"));
-    for (const v of [hi, 0, lo]) {
-      if (v !== 0 && Math.abs(y(v) - y(0)) < small + 3) continue; // would sit on the 0 label
-      parts.push(`<text x="${left - 4}" y="${(y(v) + small / 3).toFixed(1)}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(v)}</text>`);
+    const line = (x1, y1, x2, y2, color) =>
+      `<line x1="${x1.toFixed(1)}" y1="${y1.toFixed(1)}" x2="${x2.toFixed(1)}" y2="${y2.toFixed(1)}" stroke="${color}"/>`;
+    // A narrow panel (beside the animation) lays the bars on their side, one row each, with
+    // their values in a column of their own: upright bars there had slots too narrow for
+    // their value labels ("-21.774" over "0.149").
+    const across = W < 17 * 16 * u;
+    if (across) {
+      // each row: the name and the value on a line, the bar under them across the full width
+      const top = 2 * u, barH = 10 * u, rowH = label + barH + 8 * u, pad = 4 * u;
+      const bottom = top + shown.length * rowH;
+      const H = Math.round(bottom + small + 4 * u);
+      this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+      const x = (v) => pad + ((v - lo) / (hi - lo)) * (W - 2 * pad);
+      parts.push(line(x(0), top + label + 2 * u, x(0), bottom, "#868e96"));
+      const foot = (bottom + small).toFixed(1);
+      parts.push(`<text x="${pad}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="start">${fmtJ(lo)}</text>`);
+      parts.push(`<text x="${(W - pad).toFixed(1)}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(hi)}</text>`);
+      if (Math.min(x(0) - pad, W - pad - x(0)) > 44 * u) { // clear of both ends' labels
+        parts.push(`<text x="${x(0).toFixed(1)}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="middle">0</text>`);
+      }
+      shown.forEach(([k, name, color], j) => {
+        const y = top + j * rowH;
+        parts.push(`<text x="${pad}" y="${(y + label).toFixed(1)}" font-size="${label}" fill="${color}" font-style="italic">${name}</text>`);
+        parts.push(`<text data-value-of="${k}" x="${(W - pad).toFixed(1)}" y="${(y + label).toFixed(1)}" font-size="${small}" fill="#343a40" text-anchor="end"></text>`);
+        parts.push(`<rect data-key="${k}" x="${x(0).toFixed(1)}" width="0" y="${(y + label + 3 * u).toFixed(1)}" height="${barH.toFixed(1)}" fill="${color}" opacity="0.85"/>`);
+      });
+      this.axis = { across, x, small };
+    } else {
+      const H = Math.round(150 * u);
+      this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+      const top = small + 5 * u, bottom = H - label - 10 * u;
+      const left = Math.min(52 * u, W * 0.26), width = W - left - 6;
+      const y = (v) => top + ((hi - v) / (hi - lo)) * (bottom - top);
+      const slot = width / Math.max(shown.length, 1);
+      // a value label ("-1.23e-3": up to 8 characters, ~0.6 em each) fits its bar's slot
+      const valueSize = Math.min(small, (0.96 * slot) / (0.6 * 8));
+      this.axis = { across, y, small };
+      parts.push(line(left, top, left, bottom, "#ced4da"));
+      for (const v of [hi, 0, lo]) {
+        if (v !== 0 && Math.abs(y(v) - y(0)) < small + 3) continue; // would sit on the 0 label
+        parts.push(`<text x="${left - 4}" y="${(y(v) + small / 3).toFixed(1)}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(v)}</text>`);
+      }
+      parts.push(line(left, y(0), W - 4, y(0), "#868e96"));
+      shown.forEach(([k, name, color], j) => {
+        const x = left + slot * j + slot * 0.2, w = slot * 0.6;
+        parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
+        parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${valueSize.toFixed(1)}" fill="#343a40" text-anchor="middle"></text>`);
+        parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="${(H - 6 * u).toFixed(1)}" font-size="${label}" fill="${color}" text-anchor="middle" font-style="italic">${name}</text>`);
+      });
     }
-    parts.push(line(left, y(0), W - 4, y(0), "#868e96"));
-    shown.forEach(([k, name, color], j) => {
-      const x = left + slot * j + slot * 0.2, w = slot * 0.6;
-      parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
-      parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${valueSize.toFixed(1)}" fill="#343a40" text-anchor="middle"></text>`);
-      parts.push(`<text x="${(x + w / 2).toFixed(1)}" y="${(H - 6 * u).toFixed(1)}" font-size="${label}" fill="${color}" text-anchor="middle" font-style="italic">${name}</text>`);
-    });
     this.svg.innerHTML = parts.join("");
     Object.assign(this.svg.dataset, { lo: String(lo), hi: String(hi) });
     this.rects = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`rect[data-key="${k}"]`)]));
@@ -177,16 +205,23 @@ export class Instruments {
   #updateBars(i) {
     if (!this.axis) return;
     const e = this.result.energy;
-    const { y } = this.axis;
+    const { across, small } = this.axis;
     for (const [k, rect] of Object.entries(this.rects)) {
       const v = e[k][i];
-      const a = y(0), b = y(Number.isFinite(v) ? v : 0);
-      rect.setAttribute("y", Math.min(a, b).toFixed(2));
-      rect.setAttribute("height", Math.abs(b - a).toFixed(2));
-      rect.dataset.value = String(v);
+      const at = Number.isFinite(v) ? v : 0;
       const label = this.labels[k];
       label.textContent = fmtJ(v);
-      label.setAttribute("y", String(Math.max(this.axis.small, Math.min(a, b) - 3).toFixed(1)));
+      rect.dataset.value = String(v);
+      if (across) {
+        const a = this.axis.x(0), b = this.axis.x(at);
+        rect.setAttribute("x", Math.min(a, b).toFixed(2));
+        rect.setAttribute("width", Math.abs(b - a).toFixed(2));
+        continue;
+      }
+      const a = this.axis.y(0), b = this.axis.y(at);
+      rect.setAttribute("y", Math.min(a, b).toFixed(2));
+      rect.setAttribute("height", Math.abs(b - a).toFixed(2));
+      label.setAttribute("y", String(Math.max(small, Math.min(a, b) - 3).toFixed(1)));
     }
   }
 
