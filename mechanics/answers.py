@@ -206,7 +206,9 @@ def read_answer(
 
     def read(start: int, end: int) -> sp.Expr:
         try:
-            return parse(text[start:end], names, field="answer")
+            # the typed answer is at most MAX_LENGTH characters, so at most that many tokens;
+            # its rewrite spaces them out and spells them (θ -> theta, θθ -> theta * theta)
+            return parse(text[start:end], names, field="answer", max_length=10 * MAX_LENGTH)
         except ExprError as exc:
             at = None if exc.position is None else where[min(start + exc.position, len(text))]
             message = exc.message

@@ -624,3 +624,18 @@ def test_the_parser_can_refuse_kinks_of_a_coordinate_where_it_is_differentiated(
     assert parse("abs(l)*sin(theta)", names, smooth=True) == abs(names["l"]) * sp.sin(
         names["theta"]
     )
+
+
+def test_an_answer_under_the_limit_as_typed_is_not_refused_as_too_long():
+    """1,600 typed characters were refused as 'longer than 2000 characters (2481)': the count
+    of the rewritten text, spaced between its tokens, not of what the student typed."""
+    terms = " + ".join(f"sin(theta+{k})^2+cos(theta+{k})^2-1" for k in range(1, 45))
+    answer = f"1/2 m l^2 theta_dot^2 + {terms}"
+    assert len(answer) < 2000
+    r = check(answer)
+    assert r.status_code in (200, 503), r.text  # judged (or past the check's time budget)
+    greek = "θ" * 1999  # θ θ θ … rewritten as theta * theta * …: 8 characters per θ
+    problem = one_problem(check(greek), 422)
+    assert "longer than" not in problem["message"]
+    too_long = one_problem(check("m+" * 1000 + "m"), 422)  # 2001 typed: the schema's limit
+    assert too_long["field"] == "answer" and "2000 characters" in too_long["message"]
