@@ -234,3 +234,26 @@ def test_a_string_that_stays_taut_does_not_stop():
     )
     assert "stop" not in result["stats"]
     assert result["stats"]["status"] == "ok"
+
+
+def test_a_particle_released_from_rest_in_the_cone_stops_at_the_vertex():
+    """Without angular momentum the particle slides straight down the cone's wall:
+    m(1 + cot²α) r̈ = −m g cot α, so r̈ = −g sin α cos α and it reaches r = 0 at
+    t = √(2 r₀ / (g sin α cos α)). Past that a negative r is the cone's mirror image below the
+    vertex (it used to fall for ever there): the run ends at the vertex and says so."""
+    alpha, g, r0 = 0.5, 9.81, 0.5
+    req = SimulationRequest(t_end=5, fps=60, initial={"r": r0, "phi_dot": 0.0})
+    run = simulate("particle_in_cone", None, req)
+    expected = math.sqrt(2 * r0 / (g * math.sin(alpha) * math.cos(alpha)))
+    assert run["stats"]["status"] == "stopped"
+    assert run["stats"]["stop"]["name"] == "at_vertex"
+    assert run["stats"]["stop"]["t"] == pytest.approx(expected, rel=1e-6)
+    assert any("vertex" in w for w in run["warnings"])
+    assert min(run["q"]["r"]) >= -1e-9
+
+
+def test_the_cone_refuses_a_start_on_or_below_its_vertex():
+    for r in (0.0, -0.2):
+        with pytest.raises(SpecError) as refused:
+            simulate("particle_in_cone", None, SimulationRequest(initial={"r": r}))
+        assert [e["field"] for e in refused.value.errors] == ["initial.r"]
