@@ -181,14 +181,17 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
     O = Point("O")  # noqa: E741 — the notes' name for the origin
     O.set_vel(N, 0)
 
-    def expr(value: Any, where: str, allow_velocity: bool = False) -> sp.Expr:
+    def expr(value: Any, where: str, allow_velocity: bool = False, smooth: bool = False) -> sp.Expr:
+        """``smooth``: the expression is differentiated in time (a position, a frame's angle),
+        so abs() or sign() of a coordinate in it is refused with its field (its derivative
+        stays unevaluated and every later step would fail); a force may hold sign(s_dot)."""
         table = names if allow_velocity else {k: v for k, v in names.items() if "_dot" not in k}
-        return parse(value, table, field=where)
+        return parse(value, table, field=where, smooth=smooth)
 
     frames: dict[str, FrameInfo] = {}
     for i, f in enumerate(spec.frames):
         parent = N if f.parent == "N" else frames[f.parent].frame
-        angle = expr(f.angle, f"frames[{i}].angle")
+        angle = expr(f.angle, f"frames[{i}].angle", smooth=True)
         latex, plain = _frame_latex(f.name, f.unit_vectors)
         frame = ReferenceFrame(f.name, latexs=latex)
         frame.orient_axis(parent, getattr(parent, f.axis), angle)
@@ -200,7 +203,9 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
     positions: dict[str, Vector] = {"O": Vector(0)}
     natural: dict[str, str] = {"O": "N"}
 
-    def vector(pos: Any, where: str, allow_velocity: bool = False) -> tuple[Vector, str, str]:
+    def vector(
+        pos: Any, where: str, allow_velocity: bool = False, smooth: bool = False
+    ) -> tuple[Vector, str, str]:
         """A position-like field -> (vector, frame it is written in, the place it starts from)."""
         if isinstance(pos, FramePosition):
             comps, frame_name, start = pos.components, pos.frame, pos.from_ or "O"
@@ -211,11 +216,11 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         fr = frame_of(frame_name)
         v = Vector(0)
         for j, c in enumerate(comps):
-            v += expr(c, f"{path}[{j}]", allow_velocity) * getattr(fr, "xyz"[j])
+            v += expr(c, f"{path}[{j}]", allow_velocity, smooth) * getattr(fr, "xyz"[j])
         return v, frame_name, start
 
     def place(pos: Any, where: str) -> tuple[Vector, str]:
-        v, frame_name, start = vector(pos, where)
+        v, frame_name, start = vector(pos, where, smooth=True)
         if start not in positions:
             # A body may hang from a body declared later; resolve in declaration order instead.
             raise _Unresolved(start)

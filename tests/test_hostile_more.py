@@ -639,3 +639,32 @@ def test_an_answer_under_the_limit_as_typed_is_not_refused_as_too_long():
     assert "longer than" not in problem["message"]
     too_long = one_problem(check("m+" * 1000 + "m"), 422)  # 2001 typed: the schema's limit
     assert too_long["field"] == "answer" and "2000 characters" in too_long["message"]
+
+
+@pytest.mark.parametrize(
+    ("where", "text"),
+    [
+        (("bodies", 0, "position", 0), "l*abs(sin(theta))"),
+        (("bodies", 0, "position", 1), "-l*sign(cos(theta))"),
+    ],
+)
+def test_a_kinked_function_of_a_coordinate_in_a_position_is_refused_on_every_route(where, text):
+    """Differentiated in time, abs(sin θ) leaves an unevaluated derivative that failed every
+    later step (a 500 on derive, simulate and equilibria): refused with its field instead."""
+    spec = client.get("/api/v1/scenes/simple_pendulum").json()["spec"]
+    bodies, i, key, j = where
+    spec[bodies][i][key][j] = text
+    for route in ("derive", "simulate", "equilibria"):
+        r = client.post(f"/api/v1/{route}", json={"scene": spec})
+        assert r.status_code == 422, (route, r.text)
+        (error,) = r.json()["detail"]
+        assert error["field"] == f"bodies[0].position[{j}]"
+        assert "abs()" in error["message"] or "sign()" in error["message"]
+
+
+def test_friction_may_still_hold_the_sign_of_a_velocity():
+    r = client.post("/api/v1/derive", json={"scene_id": "incline_friction"})
+    assert r.status_code == 200
+    spec = client.get("/api/v1/scenes/incline_friction").json()["spec"]
+    assert "sign(" in json.dumps(spec)  # the point of the test: a force with sign(s_dot)
+    assert client.post("/api/v1/derive", json={"scene": spec}).status_code == 200
