@@ -15,9 +15,11 @@ const MAX_STEPS = 60000;
 export const PREVIEW_LABEL = "live preview (browser RK4)";
 
 export class LiveModel {
-  /** The scene's module and its slots' names; null when the server has none for it. */
-  static async load(sceneId) {
-    const meta = await getJSON(`/api/v1/scenes/${encodeURIComponent(sceneId)}/live`);
+  /** The scene's module and its slots' names; null when the server has none for it. `meta`:
+   * the slots' names the page already carries (templates/scene.html), which saves asking /live;
+   * its module is then preloaded by the page too. */
+  static async load(sceneId, meta = null) {
+    meta ||= await getJSON(`/api/v1/scenes/${encodeURIComponent(sceneId)}/live`);
     const mod = await import(meta.module);
     return new LiveModel(meta, mod);
   }

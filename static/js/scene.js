@@ -7,7 +7,7 @@
 // moves, and lets a body be dragged to its starting place. The preview is labelled as such until
 // the server's run (the measured one, which the integrator panel, plots and compare mode show)
 // replaces it; the server is asked when a slider is let go.
-import { getJSON, postJSON, typeset } from "./api.js";
+import { busy, getJSON, holdMathJax, postJSON, track, typeset } from "./api.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
 import { renderSteps } from "./derivation.js";
 import { Stage } from "./draw.js";
@@ -26,6 +26,10 @@ const $ = (id) => document.getElementById(id);
  * frames between two samples are interpolated: live.js forDisplay). */
 const SERVER_FPS = 30;
 const DISPLAY_FACTOR = 2;
+/** The derivation's math waits for the canvas to move, at most this long (ms). */
+const MATH_WAIT_MS = 600;
+/** The first plots wait for the math, at most this long (ms). */
+const PLOTS_WAIT_MS = 3000;
 
 export async function mountScene({ sceneId = null, spec = null, derivation = null }) {
   const view = new SceneView(sceneId);
@@ -55,20 +59,30 @@ class SceneView {
 
   async start(spec, derivation) {
     // Everything a built-in scene needs is asked for at once: the spec, the derivation and the
-    // live equations do not wait for each other.
+    // live equations do not wait for each other. The page usually carries them already
+    // (templates/scene.html): then nothing waits for a round trip.
+    const inline = this.sceneId ? inlineData() : {};
     let derived = derivation;
+    this.motion = settleOnce(); // resolved once the canvas moves, or is known not to soon
+    this.mathDone = settleOnce(); // resolved once the derivation is typeset (or failed)
+    holdMathJax(this.motion);
     if (this.sceneId) {
-      derived = derivation || postJSON("/api/v1/derive", this.target());
+      derived = derivation || inline.derivation || postJSON("/api/v1/derive", this.target());
       derived.catch?.(() => {}); // shown by derive(); not an unhandled rejection meanwhile
-      LiveModel.load(this.sceneId)
+      LiveModel.load(this.sceneId, inline.live)
         .then((live) => { // a preview only while the server's run is not there yet
           this.live = live;
           $("canvas").dataset.live = "ready";
           if (!this.result) this.preview();
         })
-        .catch((err) => { $("canvas").dataset.live = `unavailable: ${err.message}`; });
+        .catch((err) => {
+          $("canvas").dataset.live = `unavailable: ${err.message}`;
+          this.motion.resolve(); // no preview coming: the math need not wait for one
+        });
+    } else {
+      this.motion.resolve();
     }
-    const specP = this.sceneId ? getJSON(`/api/v1/scenes/${this.sceneId}`) : null;
+    const specP = this.sceneId ? (inline.spec || getJSON(`/api/v1/scenes/${this.sceneId}`)) : null;
     const query = new URLSearchParams(location.search);
     this.settings = readSettings(query);
     this.phase = query.get("phase");
@@ -99,6 +113,10 @@ class SceneView {
       }
     }
     if (specP) spec = (await specP).spec;
+    // The math is typeset once the motion is on screen (typesetting holds the main thread), but
+    // never later than MATH_WAIT_MS after the page's script started.
+    setTimeout(() => this.motion.resolve(), MATH_WAIT_MS);
+    setTimeout(() => this.mathDone.resolve(), PLOTS_WAIT_MS);
     await this.load(spec, query, derived);
   }
 
@@ -228,7 +246,8 @@ class SceneView {
       delete $("canvas").dataset.error;
       // A value moved since this run was asked for: the preview on the canvas is newer; the
       // panel and the plots take the server's run, the canvas waits for the next one.
-      if (changes === this.changes || !this.live) this.#show(forDisplay(a, DISPLAY_FACTOR), "server");
+      if (changes === this.changes || !this.live) this.#show(forDisplay(a, DISPLAY_FACTOR), "server", changes);
+      else this.#label(this.shown); // the preview stays: its line now says the run is in
       this.shownB = b ? forDisplay(b, DISPLAY_FACTOR) : null;
       if (b) this.stageB.setResult(this.spec, this.shownB, this.params);
       showStats(b ? [a, b] : [a]);
@@ -241,7 +260,12 @@ class SceneView {
       this.fbd(true);
       // The plots after the motion's next frame is painted: plotly's first drawing takes a few
       // hundred ms of the main thread, which the animation should not wait behind.
-      requestAnimationFrame(() => setTimeout(() => this.#plot(), 0));
+      // The first time, after the derivation's math too: the plots lie below the fold, their
+      // library and first drawing take ~0.4 s of main thread, and the math is what a student
+      // reads first.
+      track(this.mathDone
+        .then(() => new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0))))
+        .then(() => this.#plot()));
     } catch (err) {
       if (id !== this.runs) return;
       showWarnings([`The simulation failed: ${err.message}`]);
@@ -268,6 +292,9 @@ class SceneView {
 
   #computePreview() {
     this.previewDue = false;
+    // The server's run of these very values is on the canvas already (it came in between the
+    // preview being asked for and this frame): it stays, and its line says so.
+    if (this.shown && !this.shown.stats.preview && this.shownChanges === this.changes) return;
     let run;
     try {
       run = this.live.run({ params: this.params, initial: this.initial, tEnd: this.settings.t_end, fps: 60 });
@@ -277,12 +304,14 @@ class SceneView {
       return;
     }
     this.previews++;
-    this.#show(run, "live");
+    this.#show(run, "live", this.changes);
   }
 
-  /** Put a run on canvas A: the server's, or the live preview (labelled as one). */
-  #show(run, source) {
+  /** Put a run on canvas A: the server's, or the live preview (labelled as one), of the values
+   * as they were at change number `changes`. */
+  #show(run, source, changes) {
     this.shown = run;
+    this.shownChanges = changes;
     this.stageA.setResult(this.spec, run, this.params);
     this.drag?.freeze();
     const end = run.t[run.t.length - 1];
@@ -341,8 +370,7 @@ class SceneView {
   #plot() {
     if (!this.result) return;
     if (!plotlyReady()) { // plotly is loaded once the motion is on screen (lazy.js)
-      loadPlotly().then(() => this.#plot(), () => {});
-      return;
+      return loadPlotly().then(() => this.#plot(), () => {});
     }
     document.querySelectorAll(".plot-wait").forEach((el) => el.remove());
     const s = this.settings;
@@ -404,7 +432,13 @@ class SceneView {
           this.time = end;
           if (this.playing) { this.#setPlaying(false); $("scrub").value = 1000; }
         } else if (this.time > end) this.time = end > 0 ? this.time % end : 0;
-        this.stageA.draw(this.frameIndex());
+        const frame = this.frameIndex();
+        this.stageA.draw(frame);
+        if (this.motion.pending) { // a third different frame drawn: the canvas has moved
+          this.framesSeen ||= new Set();
+          this.framesSeen.add(frame);
+          if (this.framesSeen.size >= 3) this.motion.resolve();
+        }
         this.drag.overlay();
         if (this.shownB) this.stageB.draw(this.frameIndex(this.shownB));
         $("clock").textContent = `t = ${this.time.toFixed(2)} s`;
@@ -443,6 +477,7 @@ class SceneView {
       this.derivation = given ? await given : await postJSON("/api/v1/derive", this.target());
     } catch (err) {
       steps.replaceChildren(Object.assign(document.createElement("li"), { className: "errors", textContent: err.message }));
+      this.mathDone.resolve();
       return;
     }
     renderSteps(steps, this.derivation, { target: () => this.target(), coordinates: this.spec.coordinates });
@@ -458,10 +493,18 @@ class SceneView {
       el.style.visibility = hide ? "hidden" : "";
     });
     if (window.MathJax) items.forEach((item) => raw(item, true));
-    for (const item of items) {
-      await typeset([item]);
-      raw(item, false);
-      await new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+    const done = busy("Typesetting the equations…");
+    try {
+      await this.motion;
+      for (const item of items) {
+        await typeset([item]);
+        raw(item, false);
+        // a task of its own per step: a frame due meanwhile is drawn between two steps
+        await new Promise((resolve) => setTimeout(resolve, 0));
+      }
+    } finally {
+      done();
+      this.mathDone.resolve();
     }
     steps.dataset.typeset = "1";
     if (this.derivation.provenance) { // where each term comes from: tables under each equation
@@ -520,6 +563,35 @@ class SceneView {
     this.preview();
     this.schedule(0);
   }
+}
+
+/** The spec, the live equations' slots and the derivation the page carries in its HTML
+ * (templates/scene.html), each as a resolved promise; a part the page does not carry is absent. */
+function inlineData() {
+  const read = (id) => {
+    const el = document.getElementById(id);
+    if (!el) return undefined;
+    try {
+      return JSON.parse(el.textContent);
+    } catch {
+      return undefined; // the script asks the API instead
+    }
+  };
+  const spec = read("scene-spec"), live = read("scene-live"), derivation = read("scene-derivation");
+  return {
+    spec: spec && Promise.resolve(spec),
+    live: live || null,
+    derivation: derivation && Promise.resolve(derivation),
+  };
+}
+
+/** A promise resolved by whoever gets there first; `pending` until then. */
+function settleOnce() {
+  let resolve;
+  const p = new Promise((r) => { resolve = r; });
+  p.pending = true;
+  p.resolve = () => { p.pending = false; resolve(); };
+  return p;
 }
 
 /** The line under the animation that says what it shows: a live preview or the server's run. */

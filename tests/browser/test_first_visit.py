@@ -88,7 +88,8 @@ def test_the_catalog_draws_every_scene_from_one_request(server, fresh):
     page.on("request", lambda r: "/api/" in r.url and api.append(r.url))
     page.goto(f"{server}/")
     page.wait_for_function(
-        "() => [...document.querySelectorAll('svg[data-thumb]')].every(s => s.dataset.ready)",
+        "() => [...document.querySelectorAll('svg[data-thumb]')]"
+        ".every(s => ['1', 'error'].includes(s.dataset.ready))",  # not 'waiting'
         timeout=90_000,
     )
     ready = page.eval_on_selector_all("svg[data-thumb]", "els => els.map(e => e.dataset.ready)")
