@@ -61,7 +61,7 @@ function waitFor(url) {
 }
 
 /** The bar at the top of the page (built here, so every page has it without a template of its
- * own): an indeterminate progressbar, the things waited for in words beside it. */
+ * own): an indeterminate progressbar, the things waited for in words in the bottom corner. */
 function showProgress() {
   const root = document.documentElement;
   let bar = document.getElementById("progress");
@@ -85,7 +85,8 @@ function showProgress() {
       { duration: 1100, iterations: Infinity });
     const words = document.createElement("span");
     words.className = "progress-words";
-    Object.assign(words.style, { position: "absolute", top: "4px", right: "8px", padding: "0.1rem 0.5rem",
+    // at the bottom corner: at the top it would cover the top bar's buttons
+    Object.assign(words.style, { position: "fixed", bottom: "8px", right: "8px", padding: "0.1rem 0.5rem",
       font: "0.8rem system-ui, sans-serif", background: "#e7f5ff", color: "#1864ab",
       border: "1px solid #a5d8ff", borderRadius: "4px" });
     bar.append(stripe, words);
