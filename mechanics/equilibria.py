@@ -115,6 +115,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     found: list[tuple[Derivation, Root]] = []
     variants, notes = _once(d, "variants", "", lambda: _variants(d))
     warnings += notes
+    idle = _idle_at(m, conditions, values)
+    if idle:
+        warnings.append(_idle_note(m, idle, len(idle) == len(m.q)))
     for variant in variants:
         if variant.label and len(variants) > 1:
             conds = _once(d, "at rest", variant.label, functools.partial(_at_rest, variant))
@@ -123,6 +126,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         if len(variants) > 1:
             steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
         conds = [_drop_idle_drive(d, c, values) for c in conds]
+        conds = [sp.S.Zero if j in idle else c for j, c in enumerate(conds)]
         try:
             roots, notes = _equilibrium_points(variant, conds, values, periods)
         except _ConditionsOverflow as exc:
@@ -140,7 +144,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             f"{MAX_EQUILIBRIA} are listed."
         )
         found = found[:MAX_EQUILIBRIA]
-    free = [j for j, c in enumerate(conditions) if c == 0]
+    free = sorted({j for j, c in enumerate(conditions) if c == 0} | set(idle))
     results, verdicts = [], []
     for variant, root in found:
         q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
@@ -170,6 +174,38 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     if not results and not dry:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _idle_at(m: Any, conditions: list[sp.Expr], values: dict) -> list[int]:
+    """Coordinates whose force at rest vanishes for every value of them at these parameters
+    (a pendulum's Q_θ = −m g l sin θ with g = 0) and that no other condition holds: every value
+    is an equilibrium. Searched for points, the family came out as a score of sampled 'marginal'
+    equilibria and a note that sympy had missed them. Only a zero parameter can do this to a
+    condition that is not 0 for all parameters, so the check costs nothing otherwise."""
+    if not any(float(v) == 0 for v in values.values()):  # sympy: Float(0.0) != 0
+        return []
+    at = [c.xreplace(values) for c in conditions]
+    zero = [
+        j
+        for j, (c, a) in enumerate(zip(conditions, at, strict=True))
+        if c != 0 and (a == 0 or a.is_zero is True)
+    ]
+    return [j for j in zero if not any(a.has(m.q[j]) for a in at)]
+
+
+def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
+    names = ", ".join(m.coordinate_names[j] for j in idle)
+    if everything:
+        return (
+            "No force acts at rest at these parameters (every Q_j vanishes at q̇ = 0): every "
+            "configuration is an equilibrium, and each is neutral: a nudge starts a drift at "
+            "constant speed, nothing pulls it back. The list shows one of them."
+        )
+    return (
+        f"At these parameters no force acts at rest along {names} (its Q vanishes for every "
+        f"value of it): every value of {names} is an equilibrium (a family); the list shows "
+        f"{names} = 0 of each."
+    )
 
 
 def _dry_friction(d: Derivation) -> bool:
@@ -929,6 +965,16 @@ def _classify(M, C, K, n_free, names):
             reason += "; K has a negative eigenvalue: the potential has no minimum here"
         return "unstable", reason, lam, vecs
     zero = np.abs(lam) <= 1e-6 * scale
+    if n_free == n:
+        return (
+            "marginal",
+            "every coordinate is free: no force acts at rest in any direction (K = 0), so every "
+            "nearby configuration is an equilibrium too, and a nudge in velocity drifts on "
+            "without a force pulling it back (neutral, not stable; eigenvalues "
+            f"{shown})",
+            lam,
+            vecs,
+        )
     if k_null > n_free:
         return (
             "marginal",
