@@ -87,11 +87,16 @@ export function buildControls(box, rows, onChange, onCommit = () => {}) {
     Object.assign(slider, { min: lo, max: hi, step: (hi - lo) / 500 });
     slider.value = value;
     showNumber(number, value);
+    // A slider's own value is min + k·step (−1.79699099785336): below its resolution of 1/500
+    // of the range, so the value it sets is the one its box shows (−1.797), and the box, the
+    // link and the run agree. Values from elsewhere (a drag, a link) stay exact behind the box.
+    const picked = () => Number(shownValue(Number(slider.value)));
     slider.addEventListener("input", () => {
-      showNumber(number, Number(slider.value));
-      onChange(name, Number(slider.value));
+      const v = picked();
+      showNumber(number, v);
+      onChange(name, v);
     });
-    slider.addEventListener("change", () => onCommit(name, Number(slider.value)));
+    slider.addEventListener("change", () => onCommit(name, picked()));
     number.addEventListener("change", () => {
       const v = Number(number.value);
       if (number.value === "" || !Number.isFinite(v)) return;
