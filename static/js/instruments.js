@@ -153,7 +153,6 @@ export class Instruments {
       const H = Math.round(bottom + small + 4 * u);
       this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
       const x = (v) => pad + ((v - lo) / (hi - lo)) * (W - 2 * pad);
-      parts.push(line(x(0), top + label + 2 * u, x(0), bottom, "#868e96"));
       const foot = (bottom + small).toFixed(1);
       parts.push(`<text x="${pad}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="start">${fmtJ(lo)}</text>`);
       parts.push(`<text x="${(W - pad).toFixed(1)}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(hi)}</text>`);
@@ -164,6 +163,8 @@ export class Instruments {
         const y = top + j * rowH;
         parts.push(`<text x="${pad}" y="${(y + label).toFixed(1)}" font-size="${label}" fill="${color}" font-style="italic">${name}</text>`);
         parts.push(`<text data-value-of="${k}" x="${(W - pad).toFixed(1)}" y="${(y + label).toFixed(1)}" font-size="${small}" fill="#343a40" text-anchor="end"></text>`);
+        // the zero mark of each row's band only: a line down the whole panel crossed the values
+        parts.push(line(x(0), y + label + 1.5 * u, x(0), y + label + 4.5 * u + barH, "#868e96"));
         parts.push(`<rect data-key="${k}" x="${x(0).toFixed(1)}" width="0" y="${(y + label + 3 * u).toFixed(1)}" height="${barH.toFixed(1)}" fill="${color}" opacity="0.85"/>`);
       });
       this.axis = { across, x, small };
