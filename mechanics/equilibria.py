@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 import sympy as sp
+from sympy.physics.vector import Vector
 
 from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
@@ -148,6 +149,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = [], []
     for variant, root in found:
         q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
+        where = _undefined_position(m, q0, values)
+        if where is not None:
+            at = ", ".join(f"{n} = {x:.4g}" for n, x in zip(m.coordinate_names, q0, strict=True))
+            warnings.append(
+                f"The forces balance at {at}, but the position of {where} is not defined there "
+                "(its function leaves its domain, e.g. a root or a logarithm of a negative "
+                "number): the system has no such state, so it is left out."
+            )
+            continue
         try:
             with np.errstate(all="ignore"):
                 verdict = _stability(variant, q0, free, values)
@@ -157,6 +167,14 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             verdict = Verdict("marginal", _NOT_SMOOTH, [], [], [], [], None)
             if _NOT_SMOOTH_WARNING not in warnings:
                 warnings.append(_NOT_SMOOTH_WARNING)
+        except (ZeroDivisionError, TypeError):  # M infinite or complex: l*sqrt(θ) at θ = 0
+            at = ", ".join(f"{n} = {x:.4g}" for n, x in zip(m.coordinate_names, q0, strict=True))
+            warnings.append(
+                f"The forces balance at {at}, but the mass matrix is not defined there (a "
+                "position function is not differentiable, or leaves its domain, e.g. a square "
+                "root at 0): the model does not hold at that point, so it is left out."
+            )
+            continue
         verdicts.append(verdict)
         results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
@@ -174,6 +192,27 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     if not results and not dry:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _undefined_position(m: Any, q0: list[float], values: dict) -> str | None:
+    """The first body (or point) whose position is not a finite real vector at q0, if any: the
+    conditions and M may be real where a position is not (l*log(θ) at θ < 0 enters M as 1/θ²)."""
+    at = {**values, **{q: sp.Float(x) for q, x in zip(m.q, q0, strict=True)}}
+    at[m.names["t"]] = sp.S.Zero  # a frame turned by a drive (Ω t): any instant will do
+    for name, r in m.positions.items():
+        if r == Vector(0):
+            continue
+        for component in r.to_matrix(m.N):
+            value = component.xreplace(at).evalf()
+            if value.free_symbols:
+                continue  # not a number here (nothing this check can say)
+            try:
+                z = complex(value)
+            except (TypeError, ValueError, ZeroDivisionError):
+                return name
+            if not (math.isfinite(z.real) and abs(z.imag) <= 1e-12 * max(1.0, abs(z.real))):
+                return name
+    return None
 
 
 def _idle_at(m: Any, conditions: list[sp.Expr], values: dict) -> list[int]:

@@ -128,9 +128,12 @@ def _beyond_doubles(exc: BaseException) -> bool:
 
 
 def _finite(v: np.ndarray) -> bool:
-    """All entries finite? A sum of Python floats is ten times cheaper than np.isfinite on the
-    few numbers of a state, and it runs on every RHS call (NaN and ±inf propagate into it)."""
-    return math.isfinite(sum(v.tolist()))
+    """All entries finite and real? A sum of Python floats is ten times cheaper than np.isfinite
+    on the few numbers of a state, and it runs on every RHS call (NaN and ±inf propagate into
+    it). A complex entry (x**(1/3) of a negative x in a posted position) is the state leaving
+    the model's domain: not finite either (it was a 500)."""
+    total = sum(v.tolist())
+    return not isinstance(total, complex) and math.isfinite(total)
 
 
 class _Counted:
@@ -161,6 +164,11 @@ class _Counted:
             if time.perf_counter() > self.deadline:
                 raise _Stop(f"wall-time budget of {self.budget:g} s exhausted at t = {t:.6g} s")
             d = self.rhs(t, y)
+            if np.iscomplexobj(d):  # x**(1/3) of a negative x: numbers cast to real would lie
+                raise _Stop(
+                    f"the state left the domain of the scene's functions at t = {t:.6g} s (a "
+                    "root or a power of a negative number): the model ends there"
+                )
         except Exception as exc:
             if not self.fortran:
                 raise

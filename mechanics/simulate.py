@@ -374,6 +374,7 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         name: dict(zip("xyz", evaluate(fn, t, q, qd, params), strict=True))
         for name, fn in c.places.items()
     }
+    warnings += _outside_domain(c, t, q, positions)
     frames = {
         name: np.stack(evaluate(fn, t, q, qd, params), axis=1) for name, fn in c.frames.items()
     }
@@ -430,6 +431,26 @@ def _work(c, t, q, qd, params) -> dict[str, dict[str, list[float]]]:
             w = np.concatenate([[0.0], np.cumsum(np.diff(t) * (p[1:] + p[:-1]) / 2)])
         out["non_conservative"][name] = w.tolist()
     return out
+
+
+def _outside_domain(c: CompiledScene, t: np.ndarray, q: np.ndarray, positions: dict) -> list[str]:
+    """A body's position undefined at a finite state (l*sqrt(θ) once θ < 0): the equations
+    may run on, finite, but past that sample they describe no position of the system."""
+    finite_q = np.all(np.isfinite(q), axis=0)
+    for name, xyz in positions.items():
+        with np.errstate(invalid="ignore"):
+            bad = finite_q & ~np.all(
+                [np.isfinite(np.asarray(v, dtype=float)) for v in xyz.values()], axis=0
+            )
+        if bad.any():
+            i = int(np.argmax(bad))
+            at = ", ".join(f"{n} = {q[j][i]:.4g}" for j, n in enumerate(c.coordinates))
+            return [
+                f"At t = {t[i]:.4g} s ({at}) the position of {name} is undefined: the state has "
+                "left the domain of its position function (e.g. a square root of a negative "
+                "number). The motion from there on is not the system's."
+            ]
+    return []
 
 
 def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, list[float]]]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import base64
 import json
+import math
 import zlib
 
 import pytest
@@ -668,3 +669,37 @@ def test_friction_may_still_hold_the_sign_of_a_velocity():
     spec = client.get("/api/v1/scenes/incline_friction").json()["spec"]
     assert "sign(" in json.dumps(spec)  # the point of the test: a force with sign(s_dot)
     assert client.post("/api/v1/derive", json={"scene": spec}).status_code == 200
+
+
+def _pendulum_with_x(text: str) -> dict:
+    spec = client.get("/api/v1/scenes/simple_pendulum").json()["spec"]
+    spec["bodies"][0]["position"][0] = text
+    return spec
+
+
+def test_a_run_whose_state_leaves_a_positions_domain_stops_and_says_so():
+    """x = l θ^(1/3): once θ < 0 the right-hand side is complex. It was a 500 (the finiteness
+    check took a complex sum) or, cast to real by the solver, a silently wrong motion."""
+    body = {"scene": _pendulum_with_x("l*theta**(1/3)"), "t_end": 3, "initial": {"theta": 0.3}}
+    r = client.post("/api/v1/simulate", json=body)
+    assert r.status_code == 200, r.text
+    run = r.json()
+    assert run["stats"]["status"] != "ok"
+    assert any("left the domain" in w for w in run["warnings"])
+    assert all(x >= 0 for x in run["q"]["theta"][:-1])  # never drawn past the domain's end
+
+
+@pytest.mark.parametrize("text", ["l*theta**(1/3)", "l*sqrt(theta)", "l*log(theta)"])
+def test_equilibria_outside_a_positions_domain_are_left_out_with_a_reason(text):
+    """V = −m g l cos θ balances at θ = kπ for every k, but x = l√θ (or ∛θ, log θ) has no
+    state at θ < 0, and at θ = 0 its M is infinite: those points were a 500 or a 422 about
+    'units' (the complex M), or listed for a log at negative θ."""
+    r = client.post("/api/v1/equilibria", json={"scene": _pendulum_with_x(text)})
+    assert r.status_code == 200, r.text
+    out = r.json()
+    angles = [e["q"]["theta"] for e in out["equilibria"]]
+    assert angles and all(a > 0 for a in angles)
+    assert any(abs(a - math.pi) < 1e-9 for a in angles)  # still there: x is defined at π
+    at_pi = next(e for e in out["equilibria"] if abs(e["q"]["theta"] - math.pi) < 1e-9)
+    assert at_pi["kind"] == "unstable"  # V'' = m g l cos θ = −m g l < 0 at the top
+    assert any("left out" in w for w in out["warnings"])
