@@ -958,7 +958,10 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
         full_M = np.array([[num(v.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
         K_ = np.array([[-num(_derivative(fj, q)) for q in m.q] for fj in v.forcing])
         C_ = np.array([[-num(_derivative(fj, qd)) for qd in m.qd] for fj in v.forcing])
-    idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12]
+    # A row of M that vanishes here (φ at a sphere's pole), relative to the others: an
+    # absolute 1e-12 took m = 1e-13 for no inertia at all, and every equilibrium for stable.
+    inertia = float(np.max(np.abs(np.diag(full_M)), initial=0.0))
+    idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12 * inertia]
     if not idx:
         return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
     K = K_.reshape(n, n)[np.ix_(idx, idx)]
@@ -983,6 +986,15 @@ def _classify(M, C, K, n_free, names):
     lam, vecs = lam[order], vecs[:, order]
     scale = max(1.0, float(np.max(np.abs(lam))))
     tol = 1e-7 * scale
+    k_shown = np.linalg.eigvalsh((K + K.T) / 2)  # what the sentences quote: K as displayed
+    # The tests below judge K and C per unit of inertia (L⁻¹ K L⁻ᵀ with M = L Lᵀ: eigenvalues
+    # ω² in 1/s²), so that no choice of mass or length unit moves them across a tolerance: with
+    # K itself, m = 1e-10 made a pendulum's bottom 'singular, cannot decide'.
+    try:
+        inverse = np.linalg.inv(np.linalg.cholesky((M + M.T) / 2))
+        K, C = inverse @ K @ inverse.T, inverse @ C @ inverse.T
+    except np.linalg.LinAlgError:
+        pass  # M not positive definite: judge K and C as they are
     Ks, Cs = (K + K.T) / 2, (C + C.T) / 2
     k_norm = max(float(np.max(np.abs(K))), 1e-300)
     symmetric = np.max(np.abs(K - K.T)) <= 1e-9 * k_norm
@@ -1054,7 +1066,7 @@ def _classify(M, C, K, n_free, names):
     if symmetric and gyroscopic and not damped and semisimple and moving.size == on_axis.size:
         return (
             "gyroscopically stable",
-            f"K is not positive definite (its eigenvalues {', '.join(f'{k:.4g}' for k in k_eigs)}"
+            f"K is not positive definite (its eigenvalues {', '.join(f'{k:.4g}' for k in k_shown)}"
             "), but the gyroscopic (Coriolis) terms C keep every eigenvalue on the imaginary "
             f"axis without repeated defective ones ({shown}): the linearized motion stays "
             "bounded. Any damping would destroy this (Kelvin–Tait–Chetaev), and nonlinear terms "
