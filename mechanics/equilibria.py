@@ -971,14 +971,24 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
         raise _BeyondDoubles
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
     n_free = len([j for j in free if j in idx])
-    kind, reason, lam, vecs = _classify(M, C, K, n_free, [m.coordinate_names[j] for j in idx])
+    names = [m.coordinate_names[j] for j in idx]
+    kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m))
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
     return Verdict(kind, reason, list(lam), freqs, modes, phases, linear)
 
 
-def _classify(M, C, K, n_free, names):
+def _turning(m: Any) -> bool:
+    """Does a position move with time by prescription (a hoop spun at Ω)? Then K is the
+    Hessian of the effective potential, V less the centrifugal term, not of V: the bead's
+    V = −mgR cos θ has its minimum at θ = 0, where the spinning hoop's bead is unstable."""
+    return any(
+        explicit_time(component, m) for r in m.positions.values() for component in r.to_matrix(m.N)
+    )
+
+
+def _classify(M, C, K, n_free, names, *, turning: bool = False):
     n = len(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam, vecs = np.linalg.eig(A)
@@ -1013,7 +1023,9 @@ def _classify(M, C, K, n_free, names):
             f"grows like e^({grow.real:.4g} t)"
         )
         if np.min(k_eigs) < -k_tol and not gyroscopic:
-            reason += "; K has a negative eigenvalue: the potential has no minimum here"
+            reason += (
+                f"; K has a negative eigenvalue: the {_potential(turning)} has no minimum here"
+            )
         return "unstable", reason, lam, vecs
     zero = np.abs(lam) <= 1e-6 * scale
     if n_free == n:
@@ -1051,7 +1063,7 @@ def _classify(M, C, K, n_free, names):
             vecs,
         )
     if k_pd_off_free and c_psd:
-        reason = "K is positive definite, so the potential has a minimum here"
+        reason = f"K is positive definite, so the {_potential(turning)} has a minimum here"
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
             reason = (
                 "K is positive definite, so the potential (with the centrifugal term where a "
@@ -1087,6 +1099,12 @@ def _classify(M, C, K, n_free, names):
         lam,
         vecs,
     )
+
+
+def _potential(turning: bool) -> str:
+    if turning:
+        return "effective potential (V with the centrifugal term of the turning frame)"
+    return "potential"
 
 
 def _semisimple(A: np.ndarray, on_axis: np.ndarray, scale: float) -> bool:

@@ -55,3 +55,17 @@ def test_a_light_lower_bob_still_gives_the_double_pendulums_two_modes():
     assert bottom["kind"] == "stable"
     w = math.sqrt(9.81 / 1.0)
     assert sorted(bottom["frequencies"]) == [pytest.approx(w, rel=1e-3)] * 2
+
+
+def test_a_spinning_hoops_verdicts_speak_of_the_effective_potential():
+    """The bead's V = −mgR cos θ has V''(0) = mgR > 0, a minimum, yet θ = 0 is unstable at
+    Ω² > g/R: what has no minimum there is V_eff = V − ½ m R² Ω² sin²θ, with
+    V_eff''(0) = mR(g − Ω²R) < 0. Saying 'the potential has no minimum' contradicted the V
+    the page shows (student play-test)."""
+    m, R, omega, g = 0.1, 0.5, 6.0, 9.81
+    assert m * g * R > 0 and m * R * (g - omega**2 * R) < 0  # the premise, by hand
+    out = equilibria(derivation_of_scene("bead_on_hoop"), {})
+    for e in out["equilibria"]:
+        assert "effective potential" in e["reason"], e["reason"]
+    for e in equilibria(derivation_of_scene("simple_pendulum"), {})["equilibria"]:
+        assert "effective" not in e["reason"]  # nothing turns: V itself
