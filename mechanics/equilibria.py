@@ -582,7 +582,7 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
     if symbolic is None:
         notes.append(
             "sympy could not solve the conditions in closed form: the equilibria "
-            "below were found numerically."
+            "listed were found numerically."
         )
     elif len(roots) > len(symbolic):
         notes.append(

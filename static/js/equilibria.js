@@ -79,7 +79,9 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
         li.prepend(svg);
         sketch(svg, target, parameters, spec, e.q);
       }
-      const condition = e.exists_when_latex || (e.exists_when !== "always" ? e.exists_when : "");
+      // "always", or "numeric" (found by the search at these values: no condition is known)
+      const known = e.exists_when !== "always" && e.exists_when !== "numeric";
+      const condition = e.exists_when_latex || (known ? e.exists_when : "");
       const exists = condition ? ` (exists when ${e.exists_when_latex ? inline(condition) : condition})` : "";
       li.querySelector(".closed").textContent = closed + exists;
       if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.map((k) => inline(nameTex(k))).join(", ")}`;

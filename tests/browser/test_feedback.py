@@ -84,6 +84,18 @@ def test_equilibria_closed_forms_are_math(server, page):
     assert page.errors == []
 
 
+def test_equilibria_found_by_the_search_show_no_placeholder_condition(server, page):
+    """The elastic pendulum's equilibria come from the numeric search (exists_when 'numeric'):
+    the panel said '(exists when numeric)' (student play-test)."""
+    p = page.page
+    p.goto(f"{server}/scenes/elastic_pendulum")
+    wait_ready(page)
+    p.wait_for_function("document.querySelectorAll('#equilibria li').length >= 2")
+    panel = p.inner_text("#equilibria")
+    assert "numeric)" not in panel and "exists when" not in panel, panel
+    assert "below were found" not in panel
+
+
 def test_a_wrong_answer_shows_what_it_predicts(server, page):
     """The button appears after a wrong answer only; it draws both ghosts and both energies."""
     p = page.page
