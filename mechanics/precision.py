@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -435,10 +435,37 @@ def precision_compiled(c: CompiledScene, req: PrecisionRequest, seconds: float) 
         parameters=req.parameters, initial=req.initial, t_end=req.t_end, fps=1.0
     )
     params, y0 = check_request(c, sim)
+    stop = _model_ends(c, req)
+    if stop is not None:  # compare the motion the system has, not the equations' beyond it
+        req = replace(req, t_end=stop["t"])
     out = work_precision(c, params, y0, req, seconds)
     out["scene_parameters"] = dict(zip(c.parameters, params, strict=True))
     out["long_run"] = long_run(c, params, y0, req.t_end) if req.long_run else None
+    out["stopped"] = stop
     return out
+
+
+def _model_ends(c: CompiledScene, req: PrecisionRequest) -> dict[str, Any] | None:
+    """Where /simulate's run of this start ends at a declared stop (a mass at the pulley, the
+    particle at the cone's vertex), if before t_end: {"t", "message"}. The runs compared here
+    ignore stops, so past it they measured the errors of a motion the system does not have
+    (the hostile play-test's cone particle at r ≈ −205 m)."""
+    if not c.derivation.model.stops:
+        return None
+    from mechanics.simulate import simulate_compiled
+
+    probe = SimulationRequest(
+        parameters=req.parameters,
+        initial=req.initial,
+        t_end=req.t_end,
+        fps=1000.0 / req.t_end,  # its last sample is t_end itself
+        method="dop853_c",
+        check_sensitivity=False,
+    )
+    stats = simulate_compiled(c, probe)["stats"]
+    if stats["status"] != "stopped" or "stop" not in stats:
+        return None
+    return {"t": float(stats["stop"]["t"]), "message": stats["stop"]["message"]}
 
 
 def precision(

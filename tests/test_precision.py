@@ -292,3 +292,22 @@ def test_openapi_documents_the_route_with_the_registry_as_enum():
 
     assert schema["items"]["enum"] == list(METHODS)
     assert schema["maxItems"] == 6
+
+
+def test_runs_are_compared_only_up_to_where_the_model_ends():
+    """From rest in the cone (r₀ = 1) the particle reaches the vertex at
+    t = √(2 r₀ / (g sin α cos α)); the runs compared used to go on through it (the particle at
+    r ≈ −205 m by t = 10 s, an error scale of 206). Now t_end is that time, and said."""
+    from mechanics.precision import PrecisionRequest, precision
+
+    alpha, g, r0 = 0.5, 9.81, 1.0
+    vertex = math.sqrt(2 * r0 / (g * math.sin(alpha) * math.cos(alpha)))
+    req = PrecisionRequest(methods=["rk4"], initial={"r": r0, "phi_dot": 0.0})
+    out = precision("particle_in_cone", None, req)
+    assert out["stopped"]["t"] == pytest.approx(vertex, rel=1e-6)
+    assert "vertex" in out["stopped"]["message"]
+    assert out["t_end"] == pytest.approx(vertex, rel=1e-6)
+    # |y| stays within the motion up to the vertex: r ≤ r0, speeds below √(2 g h)
+    assert out["error_scale"] < 1 + r0 + math.sqrt(2 * g * r0 / math.tan(alpha)) * 2
+    steady = precision("simple_pendulum", None, PrecisionRequest(methods=["rk4"]))
+    assert steady["stopped"] is None and steady["t_end"] == 10

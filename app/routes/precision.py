@@ -121,6 +121,11 @@ class PrecisionOut(BaseModel):
     cut: bool = Field(description="True when the time budget ran out (later points stopped).")
     scene_parameters: dict[str, float]
     long_run: LongRunOut | None
+    stopped: dict[str, Any] | None = Field(
+        default=None,
+        description="Where the motion ends at a declared stop before t_end ({t, message}): "
+        "every run is compared up to there, and t_end is that time.",
+    )
 
 
 def _options(body: PrecisionIn) -> Any:

@@ -161,7 +161,8 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
     try {
       const result = await postJSON("/api/v1/precision", body);
       showTable(result);
-      status.textContent = `Done in ${num(result.seconds)} s${result.cut ? " — the time budget ran out: later points were cut short" : ""}.`;
+      const ends = result.stopped ? ` The motion ends at t = ${num(result.stopped.t)} s (${result.stopped.message}): every run is compared up to there.` : "";
+      status.textContent = `Done in ${num(result.seconds)} s${result.cut ? " — the time budget ran out: later points were cut short" : ""}.${ends}`;
       await loadPlotly().then(() => draw(result)).catch(() => {});
       root.dataset.state = "done";
     } catch (err) {
