@@ -43,9 +43,9 @@ export class BodyDrag {
     const bar = document.querySelector(".playback");
     if (!bar || $("drag-mode")) return;
     const b = Object.assign(document.createElement("button"), { id: "drag-mode", type: "button" });
-    b.title = "drag a body on the canvas to set where it starts; Shift-drag (or this toggle) sets its velocity";
+    b.title = "drag a body on the canvas to set where it starts, from rest (its velocities become 0); Shift-drag (or this toggle) sets its velocity";
     const sync = () => {
-      b.textContent = this.velocityMode ? "drag sets: velocity" : "drag sets: position";
+      b.textContent = this.velocityMode ? "drag sets: velocity" : "drag sets: position, at rest";
       b.setAttribute("aria-pressed", String(this.velocityMode));
     };
     b.addEventListener("click", () => { this.velocityMode = !this.velocityMode; sync(); });
@@ -183,9 +183,10 @@ export class BodyDrag {
       for (let j = 0; j < live.n; j++) d.y[live.n + j] = 0; // dropped from rest
     }
     const values = {};
+    const y = wrapped(live, d.y, d.p);
     live.meta.coordinates.forEach((q, j) => {
-      values[q] = d.y[j];
-      values[`${q}_dot`] = d.y[live.n + j];
+      values[q] = y[j];
+      values[`${q}_dot`] = y[live.n + j];
     });
     this.sv.setInitial(values);
   }
@@ -262,4 +263,22 @@ export class BodyDrag {
     ctx.fillText(label, lx, ly);
     ctx.restore();
   }
+}
+
+/** The state with each angle brought into (−π, π] where that changes no position: the solver
+ * may wind an angle round (φ = 11.43 after a few turns of a drag), which pinned its slider at
+ * the end of its range. A coordinate whose turns move something (a disk's roll angle) stays. */
+function wrapped(live, y, p) {
+  const out = Float64Array.from(y);
+  const before = live.places(y, p);
+  for (let j = 0; j < live.n; j++) {
+    const turns = Math.round(out[j] / (2 * Math.PI));
+    if (turns === 0) continue;
+    const trial = Float64Array.from(out);
+    trial[j] -= 2 * Math.PI * turns;
+    const after = live.places(trial, p);
+    const same = Object.keys(before).every((k) => before[k].every((x, i) => Math.abs(x - after[k][i]) <= 1e-9 * (1 + Math.abs(x))));
+    if (same) out[j] = trial[j];
+  }
+  return out;
 }
