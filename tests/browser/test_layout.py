@@ -293,3 +293,37 @@ def test_broken_equations_say_what_the_engine_wrote(server):
             broken_any += 1
             _check_broken(tex, broken)
     assert broken_any >= 5 * len(long) // 2
+
+
+#: Controls (sliders, number boxes, labels) whose right edge crosses their card's inner edge.
+CONTROLS_PAST_THEIR_CARD = """() => {
+  const out = [];
+  for (const el of document.querySelectorAll('#params .control > *, #initial .control > *')) {
+    const card = el.closest('section, .card, details');
+    if (!card || !el.getClientRects().length) continue;
+    const box = card.getBoundingClientRect();
+    const pad = parseFloat(getComputedStyle(card).paddingRight) || 0;
+    const right = el.getBoundingClientRect().right;
+    const edge = box.right - pad;
+    const name = el.id || el.tagName;
+    if (right > edge + 0.5) out.push(`${name}: ${right.toFixed(0)} > ${edge.toFixed(0)}`);
+  }
+  return out;
+}"""
+
+
+@pytest.mark.parametrize(
+    ("size", "query"), [((1024, 768), ""), ((1024, 768), "?lecture=1"), ((390, 844), "")]
+)
+def test_the_number_boxes_stay_inside_their_card(server, page, sized, size, query):
+    """At 1024 px the initial-state boxes of the double pendulum stuck 20 px out of the
+    Parameters card (the names with _dot set the label column) and the sliders shrank to 70 px
+    (student play-test); on a phone 3 px."""
+    p = page.page
+    sized(*size)
+    for scene in ("double_pendulum", "spherical_pendulum", "cart_pendulum"):
+        open_scene(p, server, scene, query)
+        p.wait_for_selector("#initial input[type=number]")
+        over = p.evaluate(CONTROLS_PAST_THEIR_CARD)
+        assert over == [], f"{scene} at {size}{query}: {over}"
+    assert not script_errors(page)
