@@ -223,6 +223,11 @@ def read_answer(
     if "=" not in text:
         return read(0, len(text)), sp.S.Zero
     equals = text.index("=")
+    double = re.search(r"=\s*=", text)  # a programmer's equality (the rewrite spaces tokens)
+    if double:
+        raise _pointed(
+            "write one '=' between the two sides, not '=='", answer, where[double.start()]
+        )
     if quantity not in ("eom", "accel") or text.count("=") > 1:
         raise _pointed(
             "'=' belongs only in an equation of motion or q̈ = ... (once)",

@@ -299,6 +299,13 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     at_start = stopped_at_start(c, params, y0)
     run = _run(c, params, y0, t_eval[:1] if at_start else t_eval, req, req.rtol, req.atol)
     warnings: list[str] = [run.note] if run.note else []
+    short = req.t_end - float(t_eval[-1])
+    if short > 1e-9 * max(1.0, req.t_end):  # samples are 1/fps apart from 0: say where they end
+        warnings.append(
+            f"Samples are 1/fps = {1 / req.fps:.4g} s apart, so the last is at "
+            f"t = {t_eval[-1]:.6g} s, {short:.3g} s short of t_end = {req.t_end:.6g} s: ask for "
+            "a t_end that is a multiple of 1/fps (or a higher fps) to get the state at t_end."
+        )
     raw = run
     if at_start is not None:
         run.status, run.message = "stopped", f"{at_start.name} at t = 0 s"

@@ -703,3 +703,33 @@ def test_equilibria_outside_a_positions_domain_are_left_out_with_a_reason(text):
     at_pi = next(e for e in out["equilibria"] if abs(e["q"]["theta"] - math.pi) < 1e-9)
     assert at_pi["kind"] == "unstable"  # V'' = m g l cos θ = −m g l < 0 at the top
     assert any("left out" in w for w in out["warnings"])
+
+
+def test_a_run_whose_samples_end_before_t_end_says_so():
+    """Samples lie on a grid of 1/fps from 0: t_end = 0.01 s at 60 fps answered t = [0] as an
+    'ok' run, with no word that the state at t_end is missing."""
+    r = client.post(
+        "/api/v1/simulate", json={"scene_id": "simple_pendulum", "t_end": 0.01, "fps": 60}
+    )
+    assert r.status_code == 200
+    run = r.json()
+    assert run["t"] == [0.0]
+    assert any("short of t_end" in w for w in run["warnings"])
+    on_grid = client.post(
+        "/api/v1/simulate", json={"scene_id": "simple_pendulum", "t_end": 7, "fps": 60}
+    ).json()
+    assert on_grid["t"][-1] == 7 and not any("short of" in w for w in on_grid["warnings"])
+
+
+def test_a_double_equals_in_an_equation_of_motion_is_named_as_such():
+    body = {
+        "scene_id": "simple_pendulum",
+        "quantity": "eom",
+        "coordinate": "theta",
+        "answer": "theta_ddot + (g/l)*sin(theta) == 0",
+    }
+    r = client.post("/api/v1/check", json=body)
+    assert r.status_code == 422
+    (error,) = r.json()["detail"]
+    assert error["field"] == "answer" and "not '=='" in error["message"]
+    assert "belongs only" not in error["message"]
