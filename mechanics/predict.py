@@ -505,6 +505,12 @@ def energy_change(
     }
 
 
+def _pct(x: float) -> str:
+    """A share as a percentage that never reads 0 % for a share the sentence is about (0.4 %
+    printed as '0%' next to 'up to 41 %' read as a contradiction, student play-test)."""
+    return f"{x:.0%}" if x >= 0.1 else f"{100 * x:.2g}%"
+
+
 def _summary(
     parted_at: float | None,
     student: Run,
@@ -527,14 +533,14 @@ def _summary(
     if abs(change) >= 1e-3:
         verb = "creates" if change > 0 else "destroys"
         parts.append(
-            f"measured with the true energy, your model {verb} energy: {abs(change):.0%} of the "
+            f"measured with the true energy, your model {verb} energy: {_pct(abs(change))} of the "
             f"true motion's largest kinetic energy ({energy['energy_scale']:.3g}) "
             f"in {energy['energy_until']:.2f} s"
-            + (f" (up to {most:.0%} along the way)" if most > 1.5 * abs(change) else "")
+            + (f" (up to {_pct(most)} along the way)" if most > 1.5 * abs(change) else "")
         )
     elif most >= 1e-3:
         parts.append(
-            f"measured with the true energy, your model's energy swings by up to {most:.0%} "
+            f"measured with the true energy, your model's energy swings by up to {_pct(most)} "
             f"of the true motion's largest kinetic energy ({energy['energy_scale']:.3g})"
         )
     window = ""

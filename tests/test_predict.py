@@ -196,3 +196,11 @@ def test_a_posted_scene_predicts_like_the_built_in_one():
     built_in = predict("g/l sin θ", quantity="accel").json()
     assert posted.json()["parted_at"] == built_in["parted_at"] is not None
     assert posted.json()["student"]["q"] == built_in["student"]["q"]
+
+
+def test_a_small_energy_share_is_not_printed_as_zero_percent():
+    from mechanics.predict import _pct
+
+    assert _pct(0.004) == "0.4%" and _pct(0.0123) == "1.2%"
+    assert _pct(0.41) == "41%" and _pct(0.1) == "10%"
+    assert "0%" not in _pct(0.001)
