@@ -151,11 +151,11 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
         where = _undefined_position(m, q0, values)
         if where is not None:
-            at = ", ".join(f"{n} = {x:.4g}" for n, x in zip(m.coordinate_names, q0, strict=True))
             warnings.append(
-                f"The forces balance at {at}, but the position of {where} is not defined there "
-                "(its function leaves its domain, e.g. a root or a logarithm of a negative "
-                "number): the system has no such state, so it is left out."
+                f"The forces balance at {_point_text(m, q0)}, but the position of {where} is "
+                "not defined there (its function leaves its domain, e.g. a root or a "
+                "logarithm of a negative number): the system has no such state, so it is "
+                "left out."
             )
             continue
         try:
@@ -168,11 +168,11 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             if _NOT_SMOOTH_WARNING not in warnings:
                 warnings.append(_NOT_SMOOTH_WARNING)
         except (ZeroDivisionError, TypeError):  # M infinite or complex: l*sqrt(θ) at θ = 0
-            at = ", ".join(f"{n} = {x:.4g}" for n, x in zip(m.coordinate_names, q0, strict=True))
             warnings.append(
-                f"The forces balance at {at}, but the mass matrix is not defined there (a "
-                "position function is not differentiable, or leaves its domain, e.g. a square "
-                "root at 0): the model does not hold at that point, so it is left out."
+                f"The forces balance at {_point_text(m, q0)}, but the mass matrix is not "
+                "defined there (a position function is not differentiable, or leaves its "
+                "domain, e.g. a square root at 0): the model does not hold at that point, so it "
+                "is left out."
             )
             continue
         verdicts.append(verdict)
@@ -192,6 +192,10 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     if not results and not dry:
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _point_text(m: Any, q0: list[float]) -> str:
+    return ", ".join(f"{n} = {x:.4g}" for n, x in zip(m.coordinate_names, q0, strict=True))
 
 
 def _undefined_position(m: Any, q0: list[float], values: dict) -> str | None:

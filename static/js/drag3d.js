@@ -8,6 +8,7 @@
 // on its cone, a bead on its hoop) goes where it is drawn nearest the pointer, its depth a
 // tie-breaker weighted DEPTH_WEIGHT of the screen's pixels, so it stays on the branch it was on.
 // Nothing is asked of the server: a few dozen position evaluations per pointer move.
+import { solveSmall } from "./live.js";
 
 /** How much a pixel of depth change counts against a pixel on the screen. */
 const DEPTH_WEIGHT = 0.03;
@@ -23,30 +24,6 @@ function screenOf(live, body, view, y, p, t) {
   return [s[0], s[1], DEPTH_WEIGHT * view.scale * s[2]];
 }
 
-/** Gaussian elimination with partial pivoting on a small dense system; null when singular. */
-function solve(A, b) {
-  const n = b.length;
-  const a = A.map((row) => Float64Array.from(row));
-  const x = Float64Array.from(b);
-  for (let c = 0; c < n; c++) {
-    let piv = c;
-    for (let r = c + 1; r < n; r++) if (Math.abs(a[r][c]) > Math.abs(a[piv][c])) piv = r;
-    if (!(Math.abs(a[piv][c]) > 0)) return null;
-    [a[c], a[piv]] = [a[piv], a[c]];
-    [x[c], x[piv]] = [x[piv], x[c]];
-    for (let r = c + 1; r < n; r++) {
-      const m = a[r][c] / a[c][c];
-      for (let j = c; j < n; j++) a[r][j] -= m * a[c][j];
-      x[r] -= m * x[c];
-    }
-  }
-  for (let r = n - 1; r >= 0; r--) {
-    let s = x[r];
-    for (let j = r + 1; j < n; j++) s -= a[r][j] * x[j];
-    x[r] = s / a[r][r];
-  }
-  return x;
-}
 
 /** Columns ∂f/∂q_j (central differences) of f(state) → 3-vector; the coordinates whose column
  * is not zero are the ones that move the body. */
@@ -74,7 +51,7 @@ function normalStep(J, r, free, lambda) {
     scale = Math.max(scale, A[i][i]);
   });
   for (let i = 0; i < m; i++) A[i][i] += lambda * (A[i][i] + 1e-9 * scale) + 1e-12;
-  return solve(A, g);
+  return solveSmall(A, g);
 }
 
 /** The coordinates (by index) that move `body` at state y: a drag changes only these. */

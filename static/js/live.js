@@ -288,7 +288,7 @@ class StopWatch {
 }
 
 /** Gaussian elimination with partial pivoting on a small dense system; null when singular. */
-function solveSmall(A, b) {
+export function solveSmall(A, b) {
   const n = b.length;
   const a = A.map((row) => Float64Array.from(row));
   const x = Float64Array.from(b);
