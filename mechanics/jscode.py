@@ -169,6 +169,19 @@ class LiveModule:
     #: Stops the preview cannot watch (on a tension): their names.
     unwatched: list[str] = field(default_factory=list)
 
+    def slots(self) -> dict:
+        """The names of its slots, as the API and the page's inline data carry them."""
+        return {
+            "coordinates": self.coordinates,
+            "parameters": self.parameters,
+            "points": self.points,
+            "frames": self.frames,
+            "solved": self.solved,
+            "extras": self.extras,
+            "stops": self.stops,
+            "unwatched_stops": self.unwatched,
+        }
+
 
 def live_module(c: CompiledScene) -> LiveModule:
     """Print the scene's right-hand side, positions, frame axes and energies as an ES module."""
@@ -294,15 +307,4 @@ def posted_live_json(key: str) -> dict:
     from mechanics.numeric import compiled_spec
 
     live = live_module(compiled_spec(json.loads(key)))
-    return {
-        "source": live.source,
-        "digest": live.digest,
-        "coordinates": live.coordinates,
-        "parameters": live.parameters,
-        "points": live.points,
-        "frames": live.frames,
-        "solved": live.solved,
-        "extras": live.extras,
-        "stops": live.stops,
-        "unwatched_stops": live.unwatched,
-    }
+    return {"source": live.source, "digest": live.digest, **live.slots()}

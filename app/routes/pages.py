@@ -158,14 +158,7 @@ async def _live_if_ready(scene_id: str) -> tuple[dict[str, Any] | None, bool]:
         return None, False
     return {
         "module": f"/api/v1/scenes/{scene_id}/live.js?v={live.digest}",
-        "coordinates": live.coordinates,
-        "parameters": live.parameters,
-        "points": live.points,
-        "frames": live.frames,
-        "solved": live.solved,
-        "extras": live.extras,
-        "stops": live.stops,
-        "unwatched_stops": live.unwatched,
+        **live.slots(),
     }, True
 
 

@@ -170,14 +170,7 @@ async def get_live(scene_id: str, request: Request) -> Response:
     live = await _live(scene_id)
     body = {
         "module": f"/api/v1/scenes/{scene_id}/live.js?v={live.digest}",
-        "coordinates": live.coordinates,
-        "parameters": live.parameters,
-        "points": live.points,
-        "frames": live.frames,
-        "solved": live.solved,
-        "extras": live.extras,
-        "stops": live.stops,
-        "unwatched_stops": live.unwatched,
+        **live.slots(),
     }
     import orjson
 
