@@ -65,10 +65,7 @@ class Watched:
         host = urlparse(origin).netloc
         page.on("console", lambda m: m.type == "error" and self.errors.append(m.text))
         page.on("pageerror", lambda e: self.errors.append(f"page error: {e}"))
-        page.on(
-            "requestfailed",
-            lambda r: self.errors.append(f"request failed: {r.url} ({r.failure})"),
-        )
+        page.on("requestfailed", self._failed)
         page.on(
             "request",
             lambda r: (
@@ -77,6 +74,13 @@ class Watched:
                 and self.errors.append(f"off-site request: {r.url}")
             ),
         )
+
+    def _failed(self, request) -> None:
+        # An API request the page cancelled itself (a run or an equilibria search superseded by
+        # a newer one: its AbortController) is the page working, not an error.
+        if "ERR_ABORTED" in str(request.failure) and "/api/" in request.url:
+            return
+        self.errors.append(f"request failed: {request.url} ({request.failure})")
 
     def settle(self, timeout: float = 60_000) -> None:
         """Wait until no API request is in flight (before leaving or reloading the page)."""
