@@ -7,7 +7,11 @@ server"), then opens each scene in a fresh browser context ("a cold browser": em
 records, from navigation start:
 
 - derivation: the steps are on the page (their text; MathJax may still be typesetting);
-- typeset: MathJax has rendered them;
+- typeset: MathJax has rendered every step;
+- in view typeset: every step the reader can see is rendered, for a reader who came for the
+  derivation: lecture mode on a 1280×720 projector (step 1 beside the animation), and a link to
+  the derivation (``#h-derivation``) at 1400×900. On the plain page the derivation is below the
+  fold; it is typeset after the animation moves, steps in view first;
 - moving: the canvas has drawn two different frames of a run (a live preview or the server's);
 - server run: the server's run is on the canvas;
 - first visit: bytes transferred (compressed, headers included) until the page settled and its
@@ -48,6 +52,13 @@ PROBE = """
     if (steps) mark("derivation");
     const list = document.querySelector("#steps");
     if (list && list.dataset.typeset === "1") mark("typeset");
+    if (steps) { // every step the reader can see now is typeset
+      const seen = [...document.querySelectorAll("#steps li.step")].filter((li) => {
+        const r = li.getBoundingClientRect();
+        return r.height > 0 && r.bottom > 0 && r.top < innerHeight;
+      });
+      if (seen.length && seen.every((li) => li.dataset.typeset === "1")) mark("typeset_view");
+    }
     const c = document.querySelector("#canvas");
     if (c && c.dataset.frame !== undefined) {
       if (frame !== null && c.dataset.frame !== frame) mark("moving");
@@ -144,6 +155,14 @@ def measure(url: str, scenes: list[str]) -> list[dict]:
                 first, first_bytes, first_n = _visit(ctx, f"{url}/scenes/{scene}")
                 _, repeat_bytes, repeat_n = _visit(ctx, f"{url}/scenes/{scene}")
                 ctx.close()
+                ctx = browser.new_context(viewport={"width": 1280, "height": 720}, bypass_csp=True)
+                ctx.add_init_script(PROBE)
+                lecture, _, _ = _visit(ctx, f"{url}/scenes/{scene}?lecture=1")
+                ctx.close()
+                ctx = browser.new_context(viewport={"width": 1400, "height": 900}, bypass_csp=True)
+                ctx.add_init_script(PROBE)
+                linked, _, _ = _visit(ctx, f"{url}/scenes/{scene}#h-derivation")
+                ctx.close()
                 rows.append(
                     {
                         "scene": scene,
@@ -151,6 +170,10 @@ def measure(url: str, scenes: list[str]) -> list[dict]:
                             k: first.get(k)
                             for k in ("derivation", "typeset", "moving", "server_run")
                         },
+                        "lecture_view": lecture.get("typeset_view"),
+                        "lecture_moving": lecture.get("moving"),
+                        "linked_view": linked.get("typeset_view"),
+                        "linked_moving": linked.get("moving"),
                         "blank_while_pause": first.get("blank_while_pause", 0),
                         "first_kB": first_bytes / 1000,
                         "first_requests": first_n,
@@ -165,10 +188,11 @@ def measure(url: str, scenes: list[str]) -> list[dict]:
 
 def table(rows: list[dict]) -> str:
     head = (
-        "| scene | derivation (ms) | typeset (ms) | moving (ms) | server run (ms) | "
+        "| scene | derivation (ms) | typeset, every step (ms) | moving (ms) | server run (ms) | "
+        "lecture: in view typeset / moving (ms) | #h-derivation: in view typeset / moving (ms) | "
         "first visit (kB, requests) | repeat (kB, requests) | 'Pause' over a blank canvas |"
     )
-    lines = [head, "|" + "---|" * 8]
+    lines = [head, "|" + "---|" * 10]
 
     def ms(v):
         return "–" if v is None else f"{v:.0f}"
@@ -176,7 +200,9 @@ def table(rows: list[dict]) -> str:
     for r in rows:
         lines.append(
             f"| {r['scene']} | {ms(r['derivation'])} | {ms(r['typeset'])} | {ms(r['moving'])} | "
-            f"{ms(r['server_run'])} | {r['first_kB']:.0f} ({r['first_requests']}) | "
+            f"{ms(r['server_run'])} | {ms(r['lecture_view'])} / {ms(r['lecture_moving'])} | "
+            f"{ms(r['linked_view'])} / {ms(r['linked_moving'])} | "
+            f"{r['first_kB']:.0f} ({r['first_requests']}) | "
             f"{r['repeat_kB']:.1f} ({r['repeat_requests']}) | {r['blank_while_pause']} frames |"
         )
     return "\n".join(lines)

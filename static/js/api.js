@@ -152,11 +152,21 @@ export async function typeset(elements) {
 }
 
 let mathHold = Promise.resolve();
+let releaseHold = () => {};
 
 /** Run MathJax's bundle only once `promise` settles (a scene page: once its animation moves),
- * whoever asks to typeset before then. */
+ * whoever asks to typeset before then — or once `releaseMathJax` is called, whichever is first. */
 export function holdMathJax(promise) {
-  mathHold = Promise.resolve(promise).catch(() => {});
+  mathHold = new Promise((resolve) => {
+    releaseHold = resolve;
+    Promise.resolve(promise).catch(() => {}).then(resolve);
+  });
+}
+
+/** Math a reader is looking at now (a derivation in view: lecture mode, a link to it) is worth
+ * more than the first frames' smoothness: stop holding MathJax back. */
+export function releaseMathJax() {
+  releaseHold();
 }
 
 /** MathJax once it has run: a page names its bundle in a <link rel="preload" data-mathjax>

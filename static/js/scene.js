@@ -7,7 +7,7 @@
 // moves, and lets a body be dragged to its starting place. The preview is labelled as such until
 // the server's run (the measured one, which the integrator panel, plots and compare mode show)
 // replaces it; the server is asked when a slider is let go.
-import { busy, getJSON, holdMathJax, postJSON, track, typeset } from "./api.js";
+import { busy, getJSON, holdMathJax, postJSON, releaseMathJax, track, typeset } from "./api.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
 import { renderSteps } from "./derivation.js";
 import { Stage } from "./draw.js";
@@ -207,7 +207,8 @@ class SceneView {
       const from = new URLSearchParams(location.search).get("from");
       if (from) q.set("from", from);
     }
-    history.replaceState(null, "", `${location.pathname}?${q}`);
+    // (the #fragment stays: a link to the derivation keeps its place)
+    history.replaceState(null, "", `${location.pathname}?${q}${location.hash}`);
   }
 
   /** Re-run after the user stops moving a control for `ms` milliseconds. */
@@ -494,15 +495,27 @@ class SceneView {
     });
     if (window.MathJax) items.forEach((item) => raw(item, true));
     const done = busy("Typesetting the equations…");
+    const view = watchInView(items);
     try {
-      await this.motion;
-      for (const item of items) {
+      await view.ready;
+      // A derivation out of sight waits for the animation to move; one in view (lecture mode, a
+      // link to it) is what the reader came for, so it starts at once.
+      if (items.some((item) => view.has(item))) releaseMathJax();
+      else await this.motion;
+      const left = new Set(items);
+      while (left.size) {
+        // the steps in view first (again after each step: the reader may have scrolled), then
+        // the rest in order; a hidden step (lecture mode) is typeset too, ready when revealed
+        const item = items.find((i) => left.has(i) && view.has(i)) || items.find((i) => left.has(i));
+        left.delete(item);
         await typeset([item]);
         raw(item, false);
+        item.dataset.typeset = "1";
         // a task of its own per step: a frame due meanwhile is drawn between two steps
         await new Promise((resolve) => setTimeout(resolve, 0));
       }
     } finally {
+      view.stop();
       done();
       this.mathDone.resolve();
     }
@@ -586,6 +599,26 @@ function inlineData() {
 }
 
 /** A promise resolved by whoever gets there first; `pending` until then. */
+/** Which of `elements` are in (or just below) the viewport now, kept up to date as the reader
+ * scrolls or lecture mode reveals a step; `ready` settles once each has been looked at once. */
+function watchInView(elements) {
+  const seen = new Set();
+  let first;
+  const ready = new Promise((resolve) => { first = resolve; });
+  if (!("IntersectionObserver" in window) || !elements.length) {
+    return { ready: Promise.resolve(), has: () => false, stop: () => {} };
+  }
+  const observer = new IntersectionObserver((entries) => {
+    for (const e of entries) {
+      if (e.isIntersecting) seen.add(e.target);
+      else seen.delete(e.target);
+    }
+    first();
+  }, { rootMargin: "0px 0px 25% 0px" });
+  elements.forEach((el) => observer.observe(el));
+  return { ready, has: (el) => seen.has(el), stop: () => observer.disconnect() };
+}
+
 function settleOnce() {
   let resolve;
   const p = new Promise((r) => { resolve = r; });

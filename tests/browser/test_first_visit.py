@@ -140,3 +140,65 @@ def test_a_repeat_visit_transfers_at_most_100_kb(server, fresh, scene):
     a second (drawn at 60 by interpolation), a double pendulum's 10 s is ~55 kB gzipped."""
     _, repeat = _scene_bytes(server, fresh, scene)
     assert sum(repeat.values()) <= REPEAT_LIMIT
+
+
+#: Records, as each derivation step is typeset, which step and whether the reader could see it.
+#: With `scroll`, the moment the steps are on the page the last one is scrolled into view, before
+#: anything is typeset (the page holds MathJax until its animation moves).
+ORDER_PROBE = """
+(scroll) => {
+  window.__typeset = [];
+  const seen = new Set();
+  new MutationObserver(() => {
+    const steps = [...document.querySelectorAll('#steps li.step')];
+    if (scroll && steps.length && !window.__scrolled) {
+      window.__scrolled = true;
+      steps[steps.length - 1].scrollIntoView({ block: 'start' });
+    }
+    for (const li of steps) {
+      if (li.dataset.typeset === '1' && !seen.has(li)) {
+        seen.add(li);
+        const r = li.getBoundingClientRect();
+        const visible = r.height > 0 && r.bottom > 0 && r.top < innerHeight;
+        window.__typeset.push([li.dataset.step, visible]);
+      }
+    }
+  }).observe(document, { subtree: true, childList: true, attributes: true,
+                         attributeFilter: ['data-typeset'] });
+}
+"""
+
+
+def test_the_steps_a_reader_looks_at_are_typeset_first(server, fresh):
+    """A student who goes straight to the end of the derivation gets the Euler–Lagrange
+    equations typeset first, not after the free-body diagram they scrolled past."""
+    fresh.add_init_script(f"({ORDER_PROBE})(true)")
+    page = fresh.new_page()
+    page.goto(f"{server}/scenes/double_pendulum")
+    _settled(page)
+    order = page.evaluate("() => window.__typeset")
+    ids = page.eval_on_selector_all("#steps li.step", "els => els.map((e) => e.dataset.step)")
+    assert sorted(s for s, _ in order) == sorted(ids)  # every step, once
+    # those in view (the end of the derivation, where the page scrolled to) first, then the rest
+    in_view = [visible for _, visible in order]
+    assert in_view[0] and in_view == sorted(in_view, reverse=True), order
+    first = [s for s, visible in order if visible]
+    assert ids[-1] in first and ids[0] not in first, order
+
+
+def test_a_link_to_the_derivation_keeps_its_place_and_typesets_what_it_shows(server, fresh):
+    """The page rewrites its URL as controls change; a #fragment (a link to the derivation, the
+    skip link's target) must survive that, and the steps it shows come first."""
+    fresh.add_init_script(f"({ORDER_PROBE})(false)")
+    page = fresh.new_page()
+    page.goto(f"{server}/scenes/simple_pendulum#h-derivation")
+    _settled(page)
+    assert page.evaluate("() => location.hash") == "#h-derivation"
+    assert (
+        page.evaluate("() => document.querySelector('#h-derivation').getBoundingClientRect().top")
+        < 200
+    )
+    order = page.evaluate("() => window.__typeset")
+    in_view = [visible for _, visible in order]
+    # those the reader sees, then the rest: no step in view waits behind one out of view
+    assert in_view[0] and in_view == sorted(in_view, reverse=True), order
