@@ -1,7 +1,8 @@
 // What a student expects from a PhET simulation, beside the animation: live energy bars (T, V, E
 // and the work of the non-conservative forces and of the drives, at the sample on screen), a
 // stopwatch and a period timer that read the simulation's clock (not the wall clock: at 0.25×
-// speed a period still measures what it is), gravity presets that move the scene's own gravity
+// speed a period still measures what it is; a period only where the coordinate swings steadily,
+// else why there is none), gravity presets that move the scene's own gravity
 // control the way a user would, and single steps (one sample back or forward, buttons and the
 // , and . keys while paused). Built from JS next to the stage's canvas; styled inline, so the page's
 // stylesheet needs nothing new. Data attributes (data-value, data-t, data-period, ...) let the
@@ -27,7 +28,8 @@ const el = (tag, props = {}, style = "") => {
   if (style) e.style.cssText = style;
   return e;
 };
-const fmtJ = (v) => (Math.abs(v) >= 100 || (Math.abs(v) < 0.01 && v !== 0) ? v.toExponential(2) : v.toFixed(3));
+// four significant digits, plain up to 10⁵ J (737.3, not 7.37e+2 beside 2.583)
+const fmtJ = (v) => (Math.abs(v) >= 1e5 || (Math.abs(v) < 0.01 && v !== 0) ? v.toExponential(2) : v.toPrecision(4));
 
 export class Instruments {
   constructor(stage) {
@@ -130,8 +132,11 @@ export class Instruments {
     let biggest = 1e-300;
     for (const k of ["T", "V", "E"]) for (const v of e[k] || []) if (Math.abs(v) > biggest) biggest = Math.abs(v);
     const shown = BARS.filter(([k, , , work]) => e[k] && (!work || e[k].some((v) => Math.abs(v) > 1e-9 * biggest)));
+    this.series = barSeries(e);
+    const datum = this.series.datum;
+    const named = (k, name) => (datum && (k === "V" || k === "E") ? `${name}′` : name);
     let lo = 0, hi = 0;
-    for (const [k] of shown) for (const v of e[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    for (const [k] of shown) for (const v of this.series[k]) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (hi - lo < 1e-12) hi = lo + 1;
     // one viewBox unit per CSS pixel, scaled with the page's root font (lecture mode's 24 px)
     const u = (parseFloat(getComputedStyle(document.documentElement).fontSize) || 16) / 16;
@@ -159,7 +164,8 @@ export class Instruments {
       if (Math.min(x(0) - pad, W - pad - x(0)) > 44 * u) { // clear of both ends' labels
         parts.push(`<text x="${x(0).toFixed(1)}" y="${foot}" font-size="${small}" fill="#5b6575" text-anchor="middle">0</text>`);
       }
-      shown.forEach(([k, name, color], j) => {
+      shown.forEach(([k, bare, color], j) => {
+        const name = named(k, bare);
         const y = top + j * rowH;
         parts.push(`<text x="${pad}" y="${(y + label).toFixed(1)}" font-size="${label}" fill="${color}" font-style="italic">${name}</text>`);
         parts.push(`<text data-value-of="${k}" x="${(W - pad).toFixed(1)}" y="${(y + label).toFixed(1)}" font-size="${small}" fill="#343a40" text-anchor="end"></text>`);
@@ -184,7 +190,8 @@ export class Instruments {
         parts.push(`<text x="${left - 4}" y="${(y(v) + small / 3).toFixed(1)}" font-size="${small}" fill="#5b6575" text-anchor="end">${fmtJ(v)}</text>`);
       }
       parts.push(line(left, y(0), W - 4, y(0), "#868e96"));
-      shown.forEach(([k, name, color], j) => {
+      shown.forEach(([k, bare, color], j) => {
+        const name = named(k, bare);
         const x = left + slot * j + slot * 0.2, w = slot * 0.6;
         parts.push(`<rect data-key="${k}" x="${x.toFixed(1)}" width="${w.toFixed(1)}" y="${y(0).toFixed(1)}" height="0" fill="${color}" opacity="0.85"/>`);
         parts.push(`<text data-value-of="${k}" x="${(x + w / 2).toFixed(1)}" y="${small}" font-size="${valueSize.toFixed(1)}" fill="#343a40" text-anchor="middle"></text>`);
@@ -197,7 +204,9 @@ export class Instruments {
     this.labels = Object.fromEntries(shown.map(([k]) => [k, this.svg.querySelector(`text[data-value-of="${k}"]`)]));
     const works = shown.filter(([, , , w]) => w).map(([, l]) => l);
     this.caption.textContent = "All bars on one axis, over the whole run. V's zero is arbitrary (where " +
-      "the datum is put), so only changes in V and E mean something." +
+      "the datum is put), so only changes in V and E mean something" +
+      (datum ? `; here from V's lowest value in this run, V_min = ${fmtJ(datum)} J: V′ = V − V_min, ` +
+        "E′ = E − V_min = T + V′, and every energy bar starts at 0." : ".") +
       (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.`
         : this.result.stats?.driven ? " A drive does work here; its bar comes with the server's run."
           : " No work is done from outside: E stays constant.");
@@ -205,7 +214,7 @@ export class Instruments {
 
   #updateBars(i) {
     if (!this.axis) return;
-    const e = this.result.energy;
+    const e = this.series;
     const { across, small } = this.axis;
     for (const [k, rect] of Object.entries(this.rects)) {
       const v = e[k][i];
@@ -276,39 +285,42 @@ export class Instruments {
     this.watchOut.dataset.elapsed = String(this.watch.elapsed);
   }
 
-  /** Upward crossings of the chosen coordinate through its mean over the run, interpolated. */
+  /** The chosen coordinate's swings over the whole run (`swings`): a period only where it
+   * swings steadily, else the reason there is none. */
   #crossings() {
     const r = this.result, name = this.periodQ.value;
-    this.ups = [];
-    if (!r || !r.q || !r.q[name]) return;
-    const q = r.q[name], t = r.t;
-    const mean = q.reduce((s, v) => s + v, 0) / q.length;
-    this.mean = mean;
-    for (let k = 0; k + 1 < q.length; k++) {
-      if (q[k] < mean && q[k + 1] >= mean) {
-        const f = (mean - q[k]) / (q[k + 1] - q[k]);
-        this.ups.push([k + 1, t[k] + f * (t[k + 1] - t[k])]);
-      }
-    }
+    this.swing = r && r.q && r.q[name] ? swings(r.t, r.q[name]) : null;
   }
 
   #updatePeriod(i) {
-    const seen = (this.ups || []).filter(([k]) => k <= i);
-    const out = this.periodOut;
+    const out = this.periodOut, sw = this.swing, name = this.periodQ.value;
+    delete out.dataset.period;
+    out.dataset.state = sw ? sw.kind : "none";
+    const small = smallOscillationPeriods();
+    const tail = small.length ? ` Small oscillations (equilibria): 2π/ω = ${small.map((p) => `${p.toFixed(3)} s`).join(", ")}.` : "";
+    if (!sw) {
+      out.textContent = "–";
+      this.periodNote.textContent = tail.trim();
+      return;
+    }
+    if (sw.kind !== "steady" && sw.kind !== "once") {
+      // the whole run says there is no period: no number at any frame, only why
+      out.textContent = "no period";
+      this.periodNote.textContent = `${name} ${sw.reason}${tail}`;
+      return;
+    }
+    const seen = sw.ups.filter(([k]) => k <= i);
     if (seen.length < 2) {
       out.textContent = "–";
-      delete out.dataset.period;
     } else {
       const period = (seen[seen.length - 1][1] - seen[0][1]) / (seen.length - 1);
       out.textContent = `T ≈ ${period.toFixed(3)} s`;
       out.dataset.period = String(period);
     }
-    const small = smallOscillationPeriods();
-    const name = this.periodQ.value;
-    this.periodNote.textContent = `Counts ${name} rising through its mean over the run` +
-      (Number.isFinite(this.mean) ? ` (${this.mean.toFixed(3)})` : "") +
-      `: ${Math.max(0, seen.length - 1)} full period${seen.length === 2 ? "" : "s"} so far.` +
-      (small.length ? ` Small oscillations (equilibria): 2π/ω = ${small.map((p) => `${p.toFixed(3)} s`).join(", ")}.` : "");
+    const n = Math.max(0, seen.length - 1);
+    this.periodNote.textContent = `Counts ${name} rising through its mean over the run (${sw.mean.toFixed(3)})` +
+      `: ${n} full period${n === 1 ? "" : "s"} so far` +
+      (sw.kind === "once" ? "; the run holds one swing only, so it is not yet seen to repeat." : ".") + tail;
   }
 
   // ------------------------------------------------------------------ gravity presets
@@ -372,6 +384,10 @@ export class Instruments {
       const keep = this.periodQ.value;
       this.periodQ.replaceChildren(...spec.coordinates.map((q) => new Option(q, q)));
       if (spec.coordinates.includes(keep)) this.periodQ.value = keep;
+      else { // the first coordinate that swings with a period, if any does (φ of a cone orbits)
+        const timed = spec.coordinates.find((q) => result.q?.[q] && ["steady", "once"].includes(swings(result.t, result.q[q]).kind));
+        if (timed) this.periodQ.value = timed;
+      }
       this.#buildGravity();
     } else if (this.gravityName) this.#markGravity();
     this.#crossings();
@@ -408,4 +424,81 @@ function smallOscillationPeriods() {
   const m = text.match(/(?:ω|\\omega)\s*=\s*([-\d.eE+,\s]+)/);
   if (!m) return [];
   return m[1].split(",").map(Number).filter((w) => Number.isFinite(w) && w > 0).map((w) => (2 * Math.PI) / w);
+}
+
+/** Steady within this fraction: the times between successive rises through the mean may differ
+ * by at most 10 % of their average (a damped oscillator's are equal; a driven one's transient, a
+ * chaotic or a quasi-periodic motion's differ by 20-50 %). */
+const STEADY = 0.1;
+
+/**
+ * Whether a coordinate sampled at times t swings back and forth with a period, judged over the
+ * whole run: its upward crossings of its mean, interpolated, as [[sample index, time], ...], and
+ * - kind "steady": three or more crossings a near-equal time apart: a period;
+ * - kind "once": two crossings only: a period, timed over one swing, not seen to repeat;
+ * - kind "irregular": the times between crossings differ by more than STEADY: no single period;
+ * - kind "monotonic" / "few": it only rises or only falls, or never comes back through its mean
+ *   twice: no period (an Atwood machine, a disk rolling down an incline).
+ * `reason` says why in words that follow the coordinate's name.
+ */
+export function swings(t, q) {
+  const n = Math.min(t.length, q.length);
+  let sum = 0, lo = Infinity, hi = -Infinity;
+  for (let k = 0; k < n; k++) { sum += q[k]; lo = Math.min(lo, q[k]); hi = Math.max(hi, q[k]); }
+  const mean = sum / Math.max(n, 1);
+  const ups = [];
+  for (let k = 0; k + 1 < n; k++) {
+    if (q[k] < mean && q[k + 1] >= mean) {
+      const f = (mean - q[k]) / (q[k + 1] - q[k]);
+      ups.push([k + 1, t[k] + f * (t[k + 1] - t[k])]);
+    }
+  }
+  const span = n ? t[n - 1] - t[0] : 0;
+  const base = { mean, ups };
+  if (ups.length < 2) {
+    const eps = 1e-9 * Math.max(hi - lo, Number.MIN_VALUE);
+    let rises = true, falls = true;
+    for (let k = 0; k + 1 < n; k++) {
+      if (q[k + 1] < q[k] - eps) rises = false;
+      if (q[k + 1] > q[k] + eps) falls = false;
+    }
+    if (!(hi > lo)) return { ...base, kind: "monotonic", reason: "stays put over this run: nothing swings, so there is no period." };
+    if (rises || falls) {
+      return { ...base, kind: "monotonic", reason: `only ${rises ? "rises" : "falls"} over this run (from ${q[0].toPrecision(3)} to ${q[n - 1].toPrecision(3)}): it does not swing back, so there is no period to time.` };
+    }
+    return { ...base, kind: "few", reason: `turns back, but does not rise through its mean (${mean.toFixed(3)}) twice in this run of ${span.toFixed(2)} s: no full swing to time (if it does swing, its period is longer than the run: raise t_end).` };
+  }
+  if (ups.length === 2) return { ...base, kind: "once", reason: "" };
+  const gaps = ups.slice(1).map(([, b], j) => b - ups[j][1]);
+  const avg = gaps.reduce((a, b) => a + b, 0) / gaps.length;
+  const least = Math.min(...gaps), most = Math.max(...gaps);
+  if (most - least > STEADY * avg) {
+    return { ...base, kind: "irregular", reason: `swings, but not with a steady period: the time from one rise through its mean to the next varies from ${least.toFixed(3)} s to ${most.toFixed(3)} s over this run (a transient, beats, or chaos), so no single period is shown.` };
+  }
+  return { ...base, kind: "steady", reason: "" };
+}
+
+/**
+ * The energies the bars show, per sample: T, V, E and the works as the run gives them, except that
+ * V and E are measured from V's lowest value over the run (`datum`) when V's own zero would
+ * crowd the bars: V below 0 somewhere (a pendulum's −mgl cos θ), or its lowest value more than
+ * 5 % of the energies that move above 0 (a datum far below the motion). V's zero is a choice of
+ * datum, so this changes no difference a student can read (ΔV, ΔE, T + V′ = E′), while every
+ * energy bar then starts at 0 and E′ ≥ T, V′: a disk rolling 150 m down an incline showed
+ * T = 737 J beside V = −735 J and an E = 2.58 J that was too short to see. Work bars are
+ * differences already (W(t) − W(0)) and are kept as they are. `datum` is 0 when nothing moved.
+ */
+export function barSeries(energy) {
+  const V = energy.V || [], T = energy.T || [];
+  let vmin = Infinity, vmax = -Infinity, tmax = 0;
+  for (const v of V) if (Number.isFinite(v)) { vmin = Math.min(vmin, v); vmax = Math.max(vmax, v); }
+  for (const v of T) if (Number.isFinite(v)) tmax = Math.max(tmax, v);
+  const moving = tmax + Math.max(0, vmax - vmin);
+  const datum = Number.isFinite(vmin) && (vmin < 0 || vmin > 0.05 * moving) ? vmin : 0;
+  const out = { ...energy, datum };
+  if (datum) {
+    out.V = V.map((v) => v - datum);
+    if (energy.E) out.E = energy.E.map((v) => v - datum);
+  }
+  return out;
 }

@@ -1,0 +1,131 @@
+"""What the new-student play-test found on the scene page, against independent values: the
+energy bars on one readable scale (a rolling disk's closed form), a period timer that times only
+what swings with a period (never a number for an Atwood machine or a disk rolling downhill), and
+the other trust findings of the page (stale statistics, lecture mode's small print, "Your turn"
+giving its answer away)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+G = 9.81
+
+
+def open_paused(page, url: str) -> None:
+    p = page.page
+    p.goto(url)
+    p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
+    page.settle()
+    if p.get_attribute("#play", "aria-pressed") != "false":
+        p.click("#play")
+    p.wait_for_timeout(150)
+
+
+def seek(p, permille: int) -> None:
+    p.eval_on_selector(
+        "#scrub", "(s, v) => { s.value = v; s.dispatchEvent(new Event('input')); }", permille
+    )
+    p.wait_for_timeout(150)
+
+
+def bars(p) -> dict[str, float]:
+    return p.eval_on_selector_all(
+        "#instruments rect[data-key]",
+        "rs => Object.fromEntries(rs.map(r => [r.dataset.key, Number(r.dataset.value)]))",
+    )
+
+
+def bar_sizes(p) -> dict[str, tuple[float, float]]:
+    """Each bar's drawn (shorter, longer) side in CSS pixels, whichever way the bars lie: a bar
+    of zero length is (0, its thickness)."""
+    return p.eval_on_selector_all(
+        "#instruments rect[data-key]",
+        """rs => Object.fromEntries(rs.map(r => { const b = r.getBoundingClientRect();
+             const w = b.width, h = b.height;
+             return [r.dataset.key, [Math.min(w, h), Math.max(w, h)]]; }))""",
+    )
+
+
+def test_a_rolling_disks_energy_bars_share_one_readable_scale(server, page):
+    """A uniform disk rolling from rest down an incline: ẍ = (2/3) g sin α, so at t_end the disk
+    has gone x₁ = (1/3) g sin α t_end² and lost m g sin α x₁ of potential energy. Measured from
+    the run's lowest V, V′(0) = E′ = m g sin α x₁ (~737 J), and E′ stays put while T and V′ trade
+    it: every bar is drawn to a scale on which E is as long as the longest bar (E was 2.58 J beside
+    T = 737 J and V = −735 J, too short to see)."""
+    p = page.page
+    m, R, alpha, t_end = 1.0, 0.3, 0.5, 10.0
+    open_paused(page, f"{server}/scenes/rolling_disk?t_end={t_end:g}")
+    x1 = G * math.sin(alpha) * t_end**2 / 3
+    drop = m * G * math.sin(alpha) * x1
+    seek(p, 0)
+    start = bars(p)
+    assert set(start) == {"T", "V", "E"}
+    assert start["T"] == pytest.approx(0, abs=1e-9)
+    assert start["V"] == pytest.approx(drop, rel=1e-6)
+    assert start["E"] == pytest.approx(drop, rel=1e-6)
+    assert float(p.get_attribute("#instruments svg", "data-lo")) == 0
+    assert float(p.get_attribute("#instruments svg", "data-hi")) == pytest.approx(drop, rel=1e-6)
+    sizes = bar_sizes(p)
+    assert sizes["E"][1] > 100 and sizes["T"][0] < 1  # E reads as the whole axis, T as nothing yet
+    for permille in (250, 500, 1000):
+        seek(p, permille)
+        b = bars(p)
+        frac = permille / 1000
+        assert b["T"] == pytest.approx(drop * frac**2, rel=1e-5)  # T ∝ x ∝ t²
+        assert b["E"] == pytest.approx(drop, rel=1e-6)
+        assert b["T"] + b["V"] == pytest.approx(b["E"], rel=1e-9)
+    # the labels say the datum moved, and to where: V = m g y of the centre, y = R cos α − x sin α
+    v_min = m * G * (R * math.cos(alpha)) - drop
+    assert "V′" in p.inner_text("#instruments .energy-bars")
+    assert f"V_min = {v_min:.4g} J" in p.inner_text("#instruments .energy-bars")
+    assert page.errors == []
+
+
+@pytest.mark.parametrize("scene", ["atwood_machine", "rolling_disk"])
+def test_no_period_where_nothing_swings(server, page, scene):
+    """Both start from rest and accelerate uniformly (an Atwood machine's heavier side falls, a
+    disk rolls down): the coordinate only grows, so no sample of the run may show a period."""
+    p = page.page
+    open_paused(page, f"{server}/scenes/{scene}")
+    for permille in (0, 500, 1000):
+        seek(p, permille)
+        assert p.get_attribute("#period", "data-period") is None
+        assert p.inner_text("#period") == "no period"
+    assert "only rises" in p.inner_text("#instruments .clocks")
+    assert page.errors == []
+
+
+def test_swings_times_only_a_steady_swing(server, page):
+    """`swings` on signals whose answer is known: cos(2πt/1.3) damped or not has period 1.3 s;
+    a ramp and a parabola never swing back; sin(t²) swings faster and faster (no single period);
+    a swing too slow for the run (period 40 s over 10 s) turns back but is not timed."""
+    p = page.page
+    open_paused(page, f"{server}/scenes/simple_pendulum")
+    got = p.evaluate(
+        """async () => {
+          const { swings } = await import('/static/js/instruments.js');
+          const t = [...Array(301).keys()].map((k) => k / 30);
+          const of = (f) => { const r = swings(t, t.map(f));
+            const n = r.ups.length;
+            const period = n > 1 ? (r.ups[n - 1][1] - r.ups[0][1]) / (n - 1) : null;
+            return [r.kind, period]; };
+          return {
+            cos: of((x) => Math.cos(2 * Math.PI * x / 1.3)),
+            damped: of((x) => Math.exp(-0.3 * x) * Math.cos(2 * Math.PI * x / 1.3)),
+            ramp: of((x) => 2 * x),
+            fall: of((x) => -x * x),
+            chirp: of((x) => Math.sin(x * x)),
+            slow: of((x) => Math.cos(2 * Math.PI * x / 40 + 1)),
+          };
+        }"""
+    )
+    assert got["cos"][0] == "steady" and got["cos"][1] == pytest.approx(1.3, rel=1e-3)
+    assert got["damped"][0] == "steady" and got["damped"][1] == pytest.approx(1.3, rel=2e-3)
+    assert got["ramp"][0] == got["fall"][0] == "monotonic"
+    assert got["chirp"][0] == "irregular"
+    assert got["slow"][0] in ("few", "monotonic")
+    assert page.errors == []
