@@ -55,20 +55,26 @@ def conserved_quantities(model: Model, work: Work) -> Step:
     parts = []
     if any(c["name"] == "energy" for c in found):
         parts.append(
-            "L has no explicit t and no non-conservative force acts, so E = T + V is "
-            "conserved (ΔT + ΔV = 0, notes III)."
+            "$L$ has no explicit $t$ and no non-conservative force acts, so $E = T + V$ is "
+            r"conserved ($\Delta T + \Delta V = 0$, notes III)."
         )
     elif any(c["name"] == "jacobi" for c in found):
         parts.append(
-            "The constraints move, so T + V is not conserved, but L has no explicit t: "
-            "the Jacobi integral h = Σ q̇_j ∂L/∂q̇_j − L is."
+            "The constraints move, so $T + V$ is not conserved, but $L$ has no explicit $t$: "
+            r"the Jacobi integral $h = \sum_j \dot q_j\, \partial L/\partial \dot q_j - L$ is."
         )
     elif not no_nc:
         parts.append(
-            "Non-conservative forces do work: dE/dt = Σ Q_j q̇_j, so E changes by W^NC (eq. 23)."
+            r"Non-conservative forces do work: $dE/dt = \sum_j Q_j \dot q_j$, so $E$ changes by "
+            r"$W^{NC}$ (eq. 23)."
         )
     else:
-        parts.append("L depends explicitly on t: neither E nor the Jacobi integral is conserved.")
+        parts.append(
+            "$L$ depends explicitly on $t$: neither $E$ nor the Jacobi integral is conserved."
+        )
     if any(c["name"] == "momentum" for c in found):
-        parts.append("A coordinate absent from L (cyclic) has a conserved momentum p_j = ∂L/∂q̇_j.")
+        parts.append(
+            r"A coordinate absent from $L$ (cyclic) has a conserved momentum "
+            r"$p_j = \partial L/\partial \dot q_j$."
+        )
     return Step("conserved", "Conserved quantities", " ".join(parts), lines)

@@ -14,15 +14,19 @@ def generalized_coordinates(model: Model, work: Work) -> Step:
     free = 3 * particles + 6 * rigid
     n = len(model.q)
     k = free - n
-    count = f"3N = {3 * particles}" if not rigid else f"3·{particles} + 6·{rigid} = {free}"
+    count = (
+        f"$3N = {3 * particles}$"
+        if not rigid
+        else rf"$3 \cdot {particles} + 6 \cdot {rigid} = {free}$"
+    )
     qs = ", ".join(to_latex(q) for q in model.q)
     text = (
         f"{len(model.bodies)} bod{'y' if len(model.bodies) == 1 else 'ies'}: {count} coordinates "
-        f"without constraints; the positions below use n = {n} generalized coordinate"
-        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs k = {k} holonomic constraint"
+        f"without constraints; the positions below use $n = {n}$ generalized coordinate"
+        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs $k = {k}$ holonomic constraint"
         f"{'s' if k != 1 else ''} "
-        f"(eq. 12). Each position r_i(q, t) satisfies {'it' if k == 1 else 'them'} for every "
-        "value of q."
+        rf"(eq. 12). Each position $\vec r_i(q, t)$ satisfies {'it' if k == 1 else 'them'} for "
+        "every value of $q$."
     )
     moving = [
         name

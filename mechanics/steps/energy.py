@@ -43,9 +43,10 @@ def energies(model: Model, work: Work) -> Step:
     work.V = tidy(V, model)
     lines += [eq_line("T", "T", work.T), eq_line("V", "V", work.V)]
     text = (
-        "T = ½ m v·v for each particle (eq. 24) and ½ m v_G·v_G + ½ ω·I_G·ω for each rigid body "
-        "(eq. 25); V sums m g h of each body above the datum (eq. 29), ½ k (ℓ − ℓ₀)² of each "
-        "spring (eq. 27) and any given potential."
+        r"$T = \tfrac12 m\,\vec v\cdot\vec v$ for each particle (eq. 24) and "
+        r"$\tfrac12 m\,\vec v_G\cdot\vec v_G + \tfrac12\,\vec\omega\cdot I_G\,\vec\omega$ for each "
+        r"rigid body (eq. 25); $V$ sums $m g h$ of each body above the datum (eq. 29), "
+        r"$\tfrac12 k(\ell - \ell_0)^2$ of each spring (eq. 27) and any given potential."
     )
     for s in model.springs:
         if s.branch is None:

@@ -212,7 +212,7 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
         return [force], (
             f"the pin reaction R acts at {where}, a point of {name} that never moves: its virtual "
             f"displacement is zero, so R does no virtual work (though R is not perpendicular to "
-            f"∂r_G/∂${to_latex(q)}$ in general)"
+            rf"$\partial \vec r_G/\partial {to_latex(q)}$ in general)"
         )
     tangent = centre.diff(q, model.N)
     normal = model.N.z.cross(tangent)
@@ -237,9 +237,9 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
         ),
     ]
     return forces, (
-        f"N and f_s act at the contact point, the point of {name} at rest while it rolls "
+        f"$N$ and $f_s$ act at the contact point, the point of {name} at rest while it rolls "
         "without slipping: its virtual displacement is zero, so they do no virtual work (though "
-        f"f_s is along ∂r_G/∂${to_latex(q)}$)"
+        rf"$f_s$ is along $\partial \vec r_G/\partial {to_latex(q)}$)"
     )
 
 
@@ -370,7 +370,8 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
         if alone and own is not None:
             note = (
                 f"{name}: its only constraint is its own; it moves only with ${coords}$, and "
-                f"{own[1]}, perpendicular to every ∂r/∂q_j, so it does no virtual work"
+                rf"{own[1]}, perpendicular to every $\partial \vec r/\partial q_j$, so it does no "
+                "virtual work"
             )
             if driven:
                 note += (
@@ -396,8 +397,8 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
             note = (
                 f"{name}: moves with ${coords}$; {' and '.join(why) or 'it shares constraints'}"
                 f", so the constraint forces on {name} need not be perpendicular to every "
-                f"∂r/∂q_j: on {name} alone they may do virtual work, summed over all bodies they "
-                "do none (ideal constraints, eq. 18–20)"
+                rf"$\partial \vec r/\partial q_j$: on {name} alone they may do virtual work, "
+                "summed over all bodies they do none (ideal constraints, eq. 18–20)"
             )
         notes.append(note)
     return forces, notes
@@ -461,8 +462,8 @@ def free_body_diagram(model: Model, work: Work) -> Step:
         datum += " and every spring at its rest length"
     text = (
         "Draw every force on every body, the constraint forces where they act. Weights, springs "
-        "and potentials are conservative and enter through V; dampers and applied forces do "
-        "non-conservative work and enter through Q_j. For ideal constraints the constraint "
+        "and potentials are conservative and enter through $V$; dampers and applied forces do "
+        "non-conservative work and enter through $Q_j$. For ideal constraints the constraint "
         "forces on all bodies together do no virtual work (notes eq. 18–20); on one body alone "
         f"only when its constraints are its own. Datum: {datum}."
     )

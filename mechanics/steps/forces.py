@@ -30,8 +30,9 @@ def generalized_forces(model: Model, work: Work) -> Step:
     if model.loads:
         text = (
             "Project every non-conservative force on the virtual displacement it works "
-            "through: Q_j = Σ F_i · ∂r_i/∂q_j (eq. 31), and torques through ∂ω/∂q̇_j."
+            r"through: $Q_j = \sum_i \vec F_i \cdot \partial \vec r_i/\partial q_j$ (eq. 31), and "
+            r"torques through $\partial \vec\omega/\partial \dot q_j$."
         )
     else:
-        text = "No non-conservative force acts: every Q_j^NC = 0 and all forces come from V."
+        text = "No non-conservative force acts: every $Q_j^{NC} = 0$ and all forces come from $V$."
     return Step("forces", "Generalized forces", text, lines)

@@ -63,12 +63,13 @@ def kinematics(model: Model, work: Work) -> Step:
                 )
             )
     text = (
-        "Write each body's position r_i(q, t) in the frame where it is natural and differentiate "
-        "in N (eq. 16)."
+        r"Write each body's position $\vec r_i(q, t)$ in the frame where it is natural and "
+        "differentiate in N (eq. 16)."
     )
     if transport:
         text += (
-            " Where the frame turns, the transport theorem v = (dr/dt)_F + ω × r (eq. 9) "
+            r" Where the frame turns, the transport theorem "
+            r"$\vec v = (d\vec r/dt)_F + \vec\omega \times \vec r$ (eq. 9) "
             "gives the velocity."
         )
     return Step("kinematics", "Kinematics", text, lines, {"transport": transport})

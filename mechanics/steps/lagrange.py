@@ -41,8 +41,10 @@ def lagrange_equations(model: Model, work: Work) -> Step:
             ),
         ]
     text = (
-        "Form L = T − V (eq. 35). For each coordinate take ∂L/∂q̇_j, its time derivative and "
-        "∂L/∂q_j; the equation of motion is d/dt ∂L/∂q̇_j − ∂L/∂q_j = Q_j^NC (eq. 36)."
+        r"Form $L = T - V$ (eq. 35). For each coordinate take $\partial L/\partial \dot q_j$, its "
+        r"time derivative and $\partial L/\partial q_j$; the equation of motion is "
+        r"$\frac{d}{dt}\frac{\partial L}{\partial \dot q_j} - \frac{\partial L}{\partial q_j}"
+        r" = Q_j^{NC}$ (eq. 36)."
     )
     return Step("lagrange", "Lagrangian and Euler–Lagrange equations", text, lines)
 

@@ -30,7 +30,10 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
         Line("M", rf"\mathbf{{M}} = {to_latex(M)}", f"M = {to_plain(M.tolist())}"),
         Line("f", rf"\mathbf{{f}} = {to_latex(f)}", f"f = {to_plain(f.T.tolist()[0])}"),
     ]
-    text = "Collect the q̈ terms: M(q, t) q̈ = f(q, q̇, t); M is symmetric and positive definite."
+    text = (
+        r"Collect the $\ddot q$ terms: $\mathbf M(q, t)\,\ddot q = \mathbf f(q, \dot q, t)$; "
+        r"$\mathbf M$ is symmetric and positive definite."
+    )
     if n <= SOLVE_MAX_COORDINATES:
         size = sp.count_ops([*M, *f])
         if size > SOLVE_OPS_BUDGET:
@@ -44,7 +47,7 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
                 model.coordinate_names, model.qdd, work.accelerations, strict=True
             ):
                 lines.append(eq_line(f"{name}_ddot", to_latex(qdd), acc, f"{name}_ddot"))
-            text += " Solved for q̈ (Cramer's rule, each piece simplified):"
+            text += r" Solved for $\ddot q$ (Cramer's rule, each piece simplified):"
     return Step("matrix", "Mass-matrix form", text, lines)
 
 
