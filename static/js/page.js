@@ -6,6 +6,9 @@
 // - On a phone, folded sections (details.fold[data-phone="closed"]) start closed, so the page is
 //   the animation and the derivation until a student opens the rest.
 // - A plot in a section just opened is redrawn at its width (plotly cannot measure a closed box).
+// - A run the server refuses (m = 0, a state past a stop) leaves the last good run's numbers in
+//   the statistics, the instruments, the plots and the work table: they are greyed and say so,
+//   with the reason, until a run goes through (`#canvas[data-error]`, set and cleared by scene.js).
 
 const PHONE = "(max-width: 600px)";
 
@@ -32,5 +35,37 @@ document.addEventListener("toggle", (e) => {
   for (const p of d.querySelectorAll(".js-plotly-plot")) window.Plotly.Plots.resize(p);
 }, true);
 
+/** What a refused run leaves behind: the panels that still show the last good run. */
+const STALE = ["#stats", "#instruments", ".plots .plot-grid", "#work-panel .work-grid"];
+
+function markStale() {
+  const canvas = document.getElementById("canvas");
+  if (!canvas) return;
+  const mark = () => {
+    const reason = canvas.dataset.error;
+    for (const selector of STALE) {
+      const part = document.querySelector(selector);
+      if (!part) continue;
+      const note = part.previousElementSibling?.classList.contains("stale-note") ? part.previousElementSibling : null;
+      part.classList.toggle("stale", Boolean(reason));
+      if (!reason) {
+        note?.remove();
+        delete part.dataset.stale;
+        continue;
+      }
+      part.dataset.stale = reason;
+      const text = "Greyed: these are the last run's numbers, not the values now set, which the " +
+        `server refused (${reason.replace(/^The simulation failed:\s*/, "")}).`;
+      const out = note || Object.assign(document.createElement("p"), { className: "stale-note" });
+      out.setAttribute("role", "status");
+      out.textContent = text;
+      if (!note) part.before(out);
+    }
+  };
+  new MutationObserver(mark).observe(canvas, { attributes: true, attributeFilter: ["data-error"] });
+  mark();
+}
+
 foldForPhones();
 watch();
+markStale();

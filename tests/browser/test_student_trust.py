@@ -129,3 +129,30 @@ def test_swings_times_only_a_steady_swing(server, page):
     assert got["chirp"][0] == "irregular"
     assert got["slow"][0] in ("few", "monotonic")
     assert page.errors == []
+
+
+def test_a_refused_run_greys_the_last_runs_numbers_with_the_reason(server, page):
+    """m = 0 leaves the pendulum no inertia (M = m l² = 0): the server refuses the run. The
+    statistics, instruments, plots and work table still hold the last run's numbers; each is
+    greyed and says why, until a run of values the server accepts comes in."""
+    p = page.page
+    open_paused(page, f"{server}/scenes/simple_pendulum")
+    parts = ["#stats", "#instruments", ".plots .plot-grid", "#work-panel .work-grid"]
+    stale = "sels => sels.map(s => document.querySelector(s).classList.contains('stale'))"
+    assert p.evaluate(stale, parts) == [False] * 4
+    p.fill("#n-m", "0")
+    p.dispatch_event("#n-m", "change")
+    p.wait_for_function("document.querySelector('#canvas').dataset.error", timeout=60_000)
+    assert p.evaluate(stale, parts) == [True] * 4
+    notes = p.eval_on_selector_all(".stale-note", "ns => ns.map(n => n.textContent)")
+    assert len(notes) == 4
+    for note in notes:
+        assert "last run" in note and "refused" in note and "parameters.m" in note
+    p.fill("#n-m", "1.5")
+    p.dispatch_event("#n-m", "change")
+    p.wait_for_function("!document.querySelector('#canvas').dataset.error", timeout=60_000)
+    page.settle()
+    assert p.evaluate(stale, parts) == [False] * 4
+    assert p.locator(".stale-note").count() == 0
+    # the refusal is the server's 422, which the page logs as a failed request: nothing else
+    assert all("422" in e or "Unprocessable" in e for e in page.errors), page.errors
