@@ -56,6 +56,15 @@ def browser():
         b.close()
 
 
+@pytest.fixture
+def fresh(browser):
+    """A context of its own: an empty cache, like a student's first visit (its CSP bypassed for
+    Playwright's polling and init scripts only)."""
+    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
+    yield ctx
+    ctx.close()
+
+
 class Watched:
     """A page with its console errors, failed requests and off-site requests collected."""
 

@@ -40,14 +40,6 @@ LABEL_PROBE = """
 """
 
 
-@pytest.fixture
-def fresh(browser):
-    """A context of its own (an empty cache); its CSP bypassed for Playwright's polling only."""
-    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
-    yield ctx
-    ctx.close()
-
-
 class Held:
     """Requests whose URL contains ``part``, held until `release` (nothing reaches the server
     meanwhile, so the page's order of events is fixed by the test, not by the machine)."""

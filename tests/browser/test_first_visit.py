@@ -40,14 +40,6 @@ BLANK_PROBE = """
 """
 
 
-@pytest.fixture
-def fresh(browser):
-    """A context of its own: an empty cache, like a student's first visit."""
-    ctx = browser.new_context(viewport={"width": 1300, "height": 900}, bypass_csp=True)
-    yield ctx
-    ctx.close()
-
-
 def _settled(page, timeout: float = 90_000) -> None:
     page.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=timeout)
     page.wait_for_selector("#steps[data-typeset='1']", state="attached", timeout=timeout)
