@@ -50,3 +50,14 @@ def test_the_probe_finds_code_like_math():
     ]
     assert all(PSEUDO_MATH.search(t) for t in before)
     assert not PSEUDO_MATH.search("bob_1 hangs from the pin at O; theta_dot")  # names stay
+
+
+@pytest.mark.parametrize("scene_id", scene_ids())
+def test_a_scenes_summary_reads_as_prose(scene_id):
+    """The summary heads the scene's page and its catalog card, where nothing typesets it: its
+    symbols are Unicode (θ, m₁, mL²), never code (x_ddot, Q^NC, theta)."""
+    from mechanics.scenes import load_scene
+
+    summary = load_scene(scene_id)["summary"]
+    assert not PSEUDO_MATH.search(summary), summary
+    assert not re.search(r"\b(theta|phi|alpha|Omega|omega|x_ddot|_dot)\b", summary), summary
