@@ -14,6 +14,12 @@ parameter ``t_end`` would write a second ``t_end`` into the link the page opens)
 
 Floats survive exactly: JSON writes them with ``repr``, the shortest text that reads back as the
 same double.
+
+A state that fits its scene must also be one the page it opens can run: `run_problems` asks the
+checks /simulate makes before it integrates (a mass or length that leaves no inertia, a state
+past a declared stop, a value that overflows, a coordinate declared positive at 0) of the run the
+page makes (`page_run`), so a link is refused with /simulate's own field and reason instead of
+opening on an error (hostile play-test: a share of m = 0 was a 200 that /simulate then refused).
 """
 
 from __future__ import annotations
@@ -27,6 +33,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from mechanics.scenes import load_scene, scene_ids
+from mechanics.simulate import SimulationRequest
+from mechanics.spec import SpecError
 
 #: The format of a token: the letter it starts with. A new format gets a new letter, and old
 #: links still decode.
@@ -86,9 +94,24 @@ def decode_state(token: str) -> dict[str, Any]:
         raise ShareError(f"the token's state is larger than {MAX_JSON} bytes")
     if not inflate.eof:
         raise ShareError("not a share token: its compressed data is cut short")
+    # said in words about the token, not Python's ('Expecting value: line 1 column 6 (char 5)',
+    # 'maximum recursion depth exceeded while decoding a JSON array from a unicode string')
     try:
-        state = json.loads(data.decode("utf-8"), parse_constant=_no_constant)
-    except (UnicodeDecodeError, ValueError, RecursionError) as exc:  # [[[[…: nesting too deep
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise ShareError("the token's state is not valid JSON (it is not UTF-8 text)") from None
+    try:
+        state = json.loads(text, parse_constant=_no_constant)
+    except json.JSONDecodeError as exc:
+        where = (
+            "breaks off"
+            if exc.pos >= len(text.rstrip())
+            else f"goes wrong at character {exc.pos + 1}"
+        )
+        raise ShareError(f"the token's state is not valid JSON (it {where})") from None
+    except RecursionError:  # [[[[…
+        raise ShareError("the token's state is not valid JSON (it is nested too deeply)") from None
+    except ValueError as exc:  # NaN, Infinity (_no_constant's words)
         raise ShareError(f"the token's state is not valid JSON ({exc})") from None
     if not isinstance(state, dict):
         raise ShareError("the token's state is not a JSON object")
@@ -159,3 +182,73 @@ _STATE_KEYS = frozenset({"method", "method_b", "dt", "t_end", "compare", "lectur
 def _listed(names: Any) -> str:
     names = sorted(names)
     return ", ".join(names) if names else "none"
+
+
+# ------------------------------------------------------------------------------ the run
+
+#: The run a scene page makes of a state (static/js/scene.js SERVER_FPS, integrator.js
+#: readSettings): 30 samples per second from the server, a step of 0.01 s for a fixed-step method
+#: and rtol = atol = 1e-9 for an adaptive one unless the state gives them.
+PAGE_FPS = 30.0
+PAGE_DT = 0.01
+PAGE_TOL = 1e-9
+#: The page's range of t_end (static/js/integrator.js clamps to it): a state outside it would not
+#: open as it was shared.
+PAGE_T_END = (0.1, 120.0)
+
+
+def page_run(state: Mapping[str, Any]) -> SimulationRequest:
+    """The /simulate request the page opened from ``state`` (JSON, as a token carries it) makes
+    for its first method."""
+    from mechanics.integrators import METHODS
+
+    method = state.get("method") or "dop853_c"
+    fixed = method in METHODS and METHODS[method].kind == "fixed"
+    rtol = state.get("rtol")
+    rtol = PAGE_TOL if rtol is None else rtol
+    atol = state.get("atol")
+    return SimulationRequest(
+        parameters=dict(state.get("parameters") or {}),
+        initial=dict(state.get("initial") or {}),
+        t_end=float(state.get("t_end", 10.0)),
+        fps=PAGE_FPS,
+        method=method,
+        rtol=rtol,
+        atol=rtol if atol is None else atol,
+        dt=(state.get("dt") or PAGE_DT) if fixed else None,
+        check_sensitivity=False,
+    )
+
+
+def run_problems(
+    scene_id: str | None, spec_key: str | None, request: SimulationRequest
+) -> list[dict[str, str]]:
+    """What /simulate refuses of ``request`` before integrating, as {field, message} (its own
+    words and fields), or [] when it would run. A built-in scene by id, a posted spec by its
+    canonical JSON (mechanics.jobs.spec_key); the same compiled scene the run uses, so this costs
+    what the run's own checks cost once the scene is compiled (a pool job for a posted spec).
+
+    A state past a spring's anchor is run by /simulate on the variant derived for that side: it
+    is checked there too, as the run does (mechanics.simulate.simulate's loop)."""
+    import json
+
+    from mechanics import simulate as run
+    from mechanics.numeric import compiled_scene, compiled_spec
+    from mechanics.stops import refuse_passed_stops
+
+    spec = json.loads(spec_key) if spec_key is not None else None
+    branches: dict[int, int] = {}
+    try:
+        for _ in range(run.MAX_BRANCH_FLIPS):
+            key = tuple(sorted(branches.items()))
+            c = compiled_scene(scene_id, key) if scene_id is not None else compiled_spec(spec, key)
+            try:
+                params, y0 = run.check_request(c, request)
+            except run._OtherBranch as other:  # the run's own retry, on the other variant
+                branches = {**c.derivation.model.branches, **other.flips}
+                continue
+            refuse_passed_stops(c, params, y0)
+            return []
+    except SpecError as exc:
+        return list(exc.errors)
+    return [{"field": "initial", "message": "no derivation matches this state"}]

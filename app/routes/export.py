@@ -14,13 +14,15 @@ from __future__ import annotations
 
 import json
 import math
+import re
+from collections.abc import Collection
 from typing import Annotated, Any, Literal
 from urllib.parse import urlencode
 
 import orjson
 from fastapi import APIRouter, HTTPException, Query, Request, Response
 from fastapi.responses import RedirectResponse
-from pydantic import BaseModel, ConfigDict, Field, StringConstraints, ValidationError
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from app import derivations
@@ -28,7 +30,14 @@ from app.routes.scenes import unknown_scene
 from app.routes.simulate import simulation_answer
 from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
 from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
-from mechanics.export_share import ShareError, decode_state, encode_state, state_problems
+from mechanics.export_share import (
+    PAGE_SETTINGS,
+    PAGE_T_END,
+    ShareError,
+    decode_state,
+    encode_state,
+    state_problems,
+)
 from mechanics.integrators import METHODS
 from mechanics.scenes import load_scene, scene_ids
 from mechanics.spec import IDENT, MAX_COORDINATES, MAX_PARAMETERS, SpecError
@@ -52,8 +61,26 @@ TOML = "application/toml; charset=utf-8"
 MAX_QUERY = 4096
 
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-Name = Annotated[str, StringConstraints(pattern=IDENT)]
-StateName = Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,27}$")]
+
+
+def _named(pattern: str, what: str) -> AfterValidator:
+    """A name checked against ``pattern`` and refused in words ("a name is a letter, then ..."),
+    not pydantic's "String should match pattern '^[A-Za-z]...'" (hostile play-test)."""
+    rule = re.compile(pattern)
+
+    def check(name: str) -> str:
+        if not rule.match(name):
+            raise ValueError(f"{name[:40]!r} is not a name: {what}")
+        return name
+
+    return AfterValidator(check)
+
+
+Name = Annotated[str, _named(IDENT, "a letter, then letters, digits or _ (24 at most)")]
+StateName = Annotated[
+    str,
+    _named(r"^[A-Za-z][A-Za-z0-9_]{0,27}$", "a letter, then letters, digits or _ (28 at most)"),
+]
 
 
 def _download(content: str | bytes, media_type: str, filename: str) -> Response:
@@ -67,6 +94,18 @@ def _download(content: str | bytes, media_type: str, filename: str) -> Response:
 
 def _file_stem(request: DeriveRequest) -> str:
     return request.scene_id or "scene"
+
+
+def _only_query(http: Request, allowed: Collection[str], reads: str) -> None:
+    """A 422 naming every query key this export does not read (hostile play-test: a misspelt
+    key was ignored, and the file came back as if it had been read). ``reads`` says what it
+    reads, for the message."""
+    unknown = [k for k in dict.fromkeys(http.query_params.keys()) if k not in allowed]
+    if unknown:
+        raise HTTPException(
+            422,
+            [{"field": k, "message": f"unknown query parameter '{k}': {reads}"} for k in unknown],
+        )
 
 
 # --------------------------------------------------------------------------------- LaTeX
@@ -83,6 +122,7 @@ async def post_latex(request: DeriveRequest, http: Request) -> Response:
     needed): the notes' procedure, every step with its prose and equations, the values, and the
     free-body diagram drawn at the initial state. Text from a posted spec is escaped: it prints,
     it never runs."""
+    _only_query(http, (), "this export reads its JSON body only")
     return _download(await _latex(request, http), TEX, f"{_file_stem(request)}.tex")
 
 
@@ -94,6 +134,7 @@ async def post_latex(request: DeriveRequest, http: Request) -> Response:
 )
 async def get_latex(scene_id: SceneId, http: Request) -> Response:
     """The same document as `POST /api/v1/export/latex` with `{"scene_id": ...}`."""
+    _only_query(http, (), "the derivation is symbolic and takes no query parameters")
     request = DeriveRequest(scene_id=scene_id)
     return _download(await _latex(request, http), TEX, f"{scene_id}.tex")
 
@@ -138,6 +179,7 @@ async def post_script(request: SimulateRequest, http: Request) -> Response:
     step) and sample times. `python run.py --json out.json` writes t, q and q_dot. It
     integrates the same state with the same right-hand side, so it agrees with the API's run to
     the run's tolerance. (Stop conditions are listed in it, not applied.)"""
+    _only_query(http, (), "this export reads its JSON body only")
     return _download(await _script(request, http), PYTHON, f"{_file_stem(request)}_run.py")
 
 
@@ -220,6 +262,7 @@ async def post_trajectory(
     """Runs the `/simulate` request and answers its trajectory as a file: t, each q and q̇,
     T, V, E, W_nc and W_drive per sample, headed by name and unit; the run's stats and warnings
     as `#` comment lines (CSV) or fields (JSON)."""
+    _only_query(http, ("format",), "this export reads format (csv or json) only")
     return await _trajectory(request, http, format)
 
 
@@ -302,11 +345,13 @@ SpecFormat = Literal["toml", "json"]
 )
 async def post_spec(
     request: DeriveRequest,
+    http: Request,
     format: Annotated[SpecFormat, Query(description="toml or json")] = "toml",
 ) -> Response:
     """The spec of a built-in scene (as written in its file) or a posted one (as validated,
     defaults left out), as TOML (`tomllib` reads it back equal) or JSON: ready to edit and post
     to `/api/v1/derive`."""
+    _only_query(http, ("format",), "this export reads format (toml or json) only")
     if request.scene_id is not None:
         return _spec_file(_builtin_spec(request.scene_id), format, request.scene_id)
     spec = request.scene.model_dump(mode="json", by_alias=True, exclude_unset=True)
@@ -322,8 +367,9 @@ async def post_spec(
     },
     summary="A built-in scene's spec as TOML or JSON",
 )
-def get_spec(scene_id: SceneId, format: SpecFormat) -> Response:
+def get_spec(scene_id: SceneId, format: SpecFormat, http: Request) -> Response:
     """The same as `POST /api/v1/export/spec` with `{"scene_id": ...}`."""
+    _only_query(http, (), "the spec is the scene's file and takes no query parameters")
     return _spec_file(_builtin_spec(scene_id), format, scene_id)
 
 
@@ -372,7 +418,12 @@ class ShareState(DeriveRequest):
     rtol: FiniteFloat | None = Field(default=None, ge=1e-14, le=0.1)
     atol: FiniteFloat | None = Field(default=None, ge=1e-16, le=1.0)
     dt: FiniteFloat | None = Field(default=None, gt=0, le=1000)
-    t_end: FiniteFloat = Field(default=10.0, ge=0, le=1000)
+    t_end: FiniteFloat = Field(
+        default=10.0,
+        ge=PAGE_T_END[0],
+        le=PAGE_T_END[1],
+        description="Seconds of motion, in the page's range (its t_end box clamps to it).",
+    )
     compare: bool = False
     method_b: MethodName | None = None  # type: ignore[valid-type]
     lecture: bool = False
@@ -392,10 +443,11 @@ class ShareLink(BaseModel):
     responses={422: _ERRORS[422]},
     summary="A link that restores a page's state",
 )
-def post_share(state: ShareState) -> ShareLink:
+async def post_share(state: ShareState, http: Request) -> ShareLink:
     """The state compressed into a URL: the link carries the scene (a posted spec too), the
     parameters, initial state, method, tolerances or step, t_end and lecture step, with every
     number exact. Nothing is stored on the server, so it works on any server, forever."""
+    _only_query(http, (), "this link is made from its JSON body only")
     document = state.model_dump(mode="json", by_alias=True, exclude_unset=True)
     problems = state_problems(document)
     if any(p["field"] == "scene_id" for p in problems):
@@ -416,10 +468,11 @@ def post_share(state: ShareState) -> ShareLink:
     responses={422: _ERRORS[422]},
     summary="The state a share link carries",
 )
-def get_share(token: str) -> ShareState:
+async def get_share(token: str, http: Request) -> ShareState:
     """The state of `/s/{token}`, as JSON (what the page restores). A token this app did not
     write answers 422 naming what is wrong with it."""
-    return _decoded(token)
+    _only_query(http, (), "a share token carries the whole state")
+    return await _decoded(token, http)
 
 
 @router.get(
@@ -429,33 +482,44 @@ def get_share(token: str) -> ShareState:
     responses={422: _ERRORS[422]},
     summary="Open a shared link",
 )
-def open_share(token: str) -> RedirectResponse:
+async def open_share(token: str, http: Request) -> RedirectResponse:
     """Redirects to the page in the shared state: a built-in scene's page with its query
     string (`step` is the lecture step), or, for a posted spec, the editor with `?share=token`
-    (the editor reads the state from `/api/v1/export/share/{token}`)."""
-    state = _decoded(token)
+    (the editor reads the state from `/api/v1/export/share/{token}`). A query string added to
+    the link on its way (a chat app's tracking key) is not the state and is left out."""
+    state = await _decoded(token, http)
     if state.scene_id is None:
         return RedirectResponse(f"/editor?{urlencode({'share': token})}", status_code=303)
     return RedirectResponse(f"/scenes/{state.scene_id}?{page_query(state)}", status_code=303)
 
 
-def _decoded(token: str) -> ShareState:
+async def _decoded(token: str, http: Request) -> ShareState:
     try:
         document = decode_state(token)
         state = ShareState.model_validate(document)
     except ShareError as exc:
         raise HTTPException(422, [{"field": "token", "message": str(exc)}]) from None
     except ValidationError as exc:
-        problems = [{"field": _token_field(e), "message": e["msg"]} for e in exc.errors()]
+        problems = [{"field": _token_field(e), "message": _plain(e["msg"])} for e in exc.errors()]
         raise HTTPException(422, problems) from None
     # a hand-made token may name a scene or values the scene does not have: said here, not by
     # the page it would open
-    problems = state_problems(state.model_dump(mode="json", by_alias=True, exclude_unset=True))
+    document = state.model_dump(mode="json", by_alias=True, exclude_unset=True)
+    problems = state_problems(document)
     if problems:
         raise HTTPException(
             422, [{"field": f"token.{p['field']}", "message": p["message"]} for p in problems]
         )
     return state
+
+
+#: pydantic names the model class a value should have been ("a valid dictionary or instance of
+#: SceneSpec"): a Python class name means nothing to whoever made the link.
+_CLASS_NAME = re.compile(r" or instance of \w+")
+
+
+def _plain(message: str) -> str:
+    return _CLASS_NAME.sub("", message).removeprefix("Value error, ")
 
 
 def _token_field(error: Any) -> str:
@@ -497,9 +561,10 @@ def page_query(state: ShareState) -> str:
 
 def _page_request(scene_id: str, http: Request) -> SimulateRequest:
     """The /simulate request a scene page's query string describes (see static/js/controls.js
-    writeQuery): values by name, ``method``, ``tol`` (rtol and atol), ``dt``, ``t_end``. Keys
-    that name nothing in the scene are ignored, as the page ignores them; a value that is not a
-    finite number is a 422 naming it."""
+    writeQuery): values by name, ``method``, ``tol`` (rtol and atol), ``dt``, ``t_end``. The
+    page's other settings (``lecture``, ``phase``, ``compare``, ...) are the page's and are
+    passed over; a key that names nothing in the scene nor the page, a key given twice, or a
+    value that is not a finite decimal number is a 422 naming it."""
     _known(scene_id)
     if len(http.url.query) > MAX_QUERY:
         raise HTTPException(422, [{"field": "query", "message": f"over {MAX_QUERY} characters"}])
@@ -508,17 +573,36 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
     names_i = {n for q in spec["coordinates"] for n in (q, f"{q}_dot")}
     query = http.query_params
     errors: list[dict[str, str]] = []
+    for key in dict.fromkeys(query.keys()):
+        if key not in names_p | names_i | PAGE_SETTINGS:
+            errors.append(
+                {
+                    "field": key,
+                    "message": f"unknown query parameter '{key}': the scene '{scene_id}' has "
+                    f"no value of that name (parameters: {_names(names_p)}; initial state: "
+                    f"{_names(names_i)}) and the page no setting of it "
+                    f"({_names(PAGE_SETTINGS)})",
+                }
+            )
+        elif len(query.getlist(key)) > 1:
+            errors.append(
+                {"field": key, "message": f"given {len(query.getlist(key))} times: give it once"}
+            )
+    if errors:
+        raise HTTPException(422, errors)
 
     def number(key: str) -> float | None:
         raw = query.get(key)
         if raw is None or raw == "":
             return None
-        try:
-            value = float(raw)
-        except ValueError:
-            value = math.nan
+        # a decimal number as the page writes one; Python's float() also reads '1_0' (as 10),
+        # 'infinity' and ' 1 ', which the page's Number() does not read the same way
+        value = float(raw) if _DECIMAL.match(raw) else math.nan
         if not math.isfinite(value):
-            errors.append({"field": key, "message": f"must be a finite number, not {raw[:40]!r}"})
+            if not any(e["field"] == key for e in errors):  # tol is read twice
+                errors.append(
+                    {"field": key, "message": f"must be a finite number, not {raw[:40]!r}"}
+                )
             return None
         return value
 
@@ -552,3 +636,11 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
             for e in exc.errors()
         ]
         raise HTTPException(422, problems) from None
+
+
+#: A decimal number: what the page writes (String of a double, repr on the server).
+_DECIMAL = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?$")
+
+
+def _names(names: Collection[str]) -> str:
+    return ", ".join(sorted(names)) or "none"
