@@ -9,6 +9,10 @@
 // - A run the server refuses (m = 0, a state past a stop) leaves the last good run's numbers in
 //   the statistics, the instruments, the plots and the work table: they are greyed and say so,
 //   with the reason, until a run goes through (`#canvas[data-error]`, set and cleared by scene.js).
+// - A "Your turn" box, once opened, hides the lines of its step that are its answer (T, V, Q_j,
+//   L, an equation of motion and the lines that work it out, q̈), until the student checks a
+//   correct answer, presses "Show answer" or the step's own "show" button, or closes the box: the
+//   derived expression just above it gave the exercise away (student play-test).
 
 const PHONE = "(max-width: 600px)";
 
@@ -66,6 +70,87 @@ function markStale() {
   mark();
 }
 
+// ------------------------------------------------------------------ "Your turn" withholds its answer
+
+/** The labels (derivation.js .line-label, the step's `labels`) of the lines that answer the k-th
+ * "Your turn" box of a step: the boxes come in derivation.js yourTurn's order (energy: T, V;
+ * forces: Q_j per coordinate; lagrange: L, then the equation of motion per coordinate; matrix: q̈
+ * per coordinate), and the coordinates in the order of the step's own labels. */
+export function answerLabels(stepId, k, labels) {
+  const nth = (pattern, j) => labels.filter((l) => pattern.test(l))[j];
+  if (stepId === "energy") return labels.filter((l) => (k === 0 ? /^T(_|$)/ : k === 1 ? /^V(_|$)/ : /^$/).test(l));
+  if (stepId === "forces") return [nth(/^Q_/, k)].filter(Boolean);
+  if (stepId === "matrix") return [nth(/_ddot$/, k)].filter(Boolean);
+  if (stepId === "lagrange") {
+    if (k === 0) return labels.filter((l) => l === "L");
+    const eom = nth(/^EoM /, k - 1);
+    if (!eom) return [];
+    const q = eom.slice(4);
+    return [eom, `dL/d${q}_dot`, `d/dt dL/d${q}_dot`, `dL/d${q}`].filter((l) => labels.includes(l));
+  }
+  return [];
+}
+
+const labelOf = (line) => line.querySelector(".line-label")?.textContent.trim() || "";
+
+/** Hide, in one step, the answers of its open and not yet revealed boxes; show the rest. */
+function withhold(step) {
+  const boxes = [...step.querySelectorAll(":scope > .yourturn")];
+  const lines = [...step.querySelectorAll(".math-line")];
+  const labels = lines.map(labelOf);
+  const hidden = new Set();
+  boxes.forEach((box, k) => {
+    if (box.open && !box.dataset.revealed) for (const l of answerLabels(step.dataset.step, k, labels)) hidden.add(l);
+  });
+  lines.forEach((line, j) => line.classList.toggle("withheld", hidden.has(labels[j])));
+  let note = step.querySelector(".withheld-note");
+  if (!hidden.size) {
+    note?.remove();
+    return;
+  }
+  if (!note) {
+    note = Object.assign(document.createElement("p"), { className: "withheld-note" });
+    const show = Object.assign(document.createElement("button"), { type: "button", className: "small", textContent: "show it" });
+    show.addEventListener("click", () => {
+      for (const box of boxes) if (box.open) box.dataset.revealed = "shown";
+      withhold(step);
+    });
+    note.append("Part of this step is hidden while you try “Your turn” below. ", show);
+  }
+  const first = lines.find((line) => line.classList.contains("withheld"));
+  if (note.nextElementSibling !== first) first.before(note);
+}
+
+function withholdAnswers() {
+  document.addEventListener("toggle", (e) => {
+    const box = e.target;
+    if (!(box instanceof HTMLDetailsElement) || !box.classList.contains("yourturn")) return;
+    const step = box.closest(".step");
+    if (!step) return;
+    const result = box.querySelector(".result");
+    if (result && !box.dataset.watched) {
+      box.dataset.watched = "1";
+      // a checked answer that is correct has earned the derivation (data-checked is set once the
+      // answer is settled and typeset)
+      new MutationObserver(() => {
+        if (box.querySelector(".verdict.ok")) {
+          box.dataset.revealed = "correct";
+          withhold(step);
+        }
+      }).observe(result, { attributes: true, attributeFilter: ["data-checked"] });
+    }
+    withhold(step);
+  }, true);
+  document.addEventListener("click", (e) => {
+    const reveal = e.target instanceof Element && e.target.closest(".yourturn .reveal");
+    if (!reveal) return;
+    const box = reveal.closest(".yourturn");
+    box.dataset.revealed = "asked";
+    withhold(box.closest(".step"));
+  }, true);
+}
+
 foldForPhones();
 watch();
 markStale();
+withholdAnswers();

@@ -156,3 +156,79 @@ def test_a_refused_run_greys_the_last_runs_numbers_with_the_reason(server, page)
     assert p.locator(".stale-note").count() == 0
     # the refusal is the server's 422, which the page logs as a failed request: nothing else
     assert all("422" in e or "Unprocessable" in e for e in page.errors), page.errors
+
+
+def visible_labels(p, step: str) -> list[str]:
+    """The labels of the lines of a derivation step that are shown."""
+    return p.eval_on_selector_all(
+        f".step[data-step='{step}'] .math-line",
+        """ls => ls.filter(l => l.getClientRects().length > 0)
+             .map(l => l.querySelector('.line-label')?.textContent.trim())""",
+    )
+
+
+def your_turn(p, step: str, k: int):
+    return p.locator(f".step[data-step='{step}'] > .yourturn").nth(k)
+
+
+def test_your_turn_hides_its_answer_until_it_is_earned(server, page):
+    """A pendulum bob at l(sin θ, −cos θ): T = ½ m l² θ̇², V = −m g l cos θ (datum at the pivot),
+    and θ̈ = −(g/l) sin θ. Opening "Your turn: T" hides T (and the bob's own T, the same
+    expression); V stays. A correct V checked brings V's lines back; "Show answer" brings T's."""
+    p = page.page
+    open_paused(page, f"{server}/scenes/simple_pendulum")
+    p.wait_for_selector(".step[data-step='energy'] .line-label")
+    assert visible_labels(p, "energy") == ["T_bob", "V_bob", "T", "V"]
+    your_turn(p, "energy", 0).locator("summary").click()
+    assert visible_labels(p, "energy") == ["V_bob", "V"]
+    assert p.locator(".step[data-step='energy'] .withheld-note").count() == 1
+    box_v = your_turn(p, "energy", 1)
+    box_v.locator("summary").click()
+    assert visible_labels(p, "energy") == []
+    box_v.locator("input").fill("-m g l cos(theta)")
+    box_v.locator("button.check").click()
+    p.wait_for_function(
+        """() => document.querySelectorAll(".step[data-step='energy'] > .yourturn")[1]
+                   .querySelector('.verdict.ok')"""
+    )
+    p.wait_for_timeout(100)
+    assert visible_labels(p, "energy") == ["V_bob", "V"]  # earned; T still withheld
+    your_turn(p, "energy", 0).locator("button.reveal").click()
+    assert visible_labels(p, "energy") == ["T_bob", "V_bob", "T", "V"]
+    assert p.locator(".step[data-step='energy'] .withheld-note").count() == 0
+    # q̈ in the mass-matrix step: its line only; a wrong answer does not earn it
+    box = your_turn(p, "matrix", 0)
+    box.locator("summary").click()
+    assert visible_labels(p, "matrix") == ["M", "f"]
+    box.locator("input").fill("-g/l theta")
+    box.locator("button.check").click()
+    box.locator(".verdict.bad").wait_for()
+    assert visible_labels(p, "matrix") == ["M", "f"]
+    p.locator(".step[data-step='matrix'] .withheld-note button").click()
+    assert visible_labels(p, "matrix") == ["M", "f", "theta_ddot"]
+
+
+def test_the_answer_labels_of_each_kind_of_box(server, page):
+    """answerLabels against a cart-pendulum's labels (x, θ): the second equation of motion is θ's
+    with the three lines that work it out; Q and q̈ by the coordinate's place."""
+    p = page.page
+    open_paused(page, f"{server}/scenes/simple_pendulum")
+    got = p.evaluate(
+        """async () => {
+          const { answerLabels } = await import('/static/js/page.js');
+          const lag = ['L', 'dL/dx_dot', 'd/dt dL/dx_dot', 'dL/dx', 'EoM x',
+                       'dL/dtheta_dot', 'd/dt dL/dtheta_dot', 'dL/dtheta', 'EoM theta'];
+          return {
+            T: answerLabels('energy', 0, ['T_cart', 'T_bob', 'V_cart', 'V_bob', 'T', 'V']),
+            Qtheta: answerLabels('forces', 1, ['Q_x', 'Q_theta']),
+            L: answerLabels('lagrange', 0, lag),
+            eomTheta: answerLabels('lagrange', 2, lag),
+            xdd: answerLabels('matrix', 0, ['M', 'f', 'x_ddot', 'theta_ddot']),
+          };
+        }"""
+    )
+    assert got["T"] == ["T_cart", "T_bob", "T"]
+    assert got["Qtheta"] == ["Q_theta"]
+    assert got["L"] == ["L"]
+    assert got["eomTheta"] == ["EoM theta", "dL/dtheta_dot", "d/dt dL/dtheta_dot", "dL/dtheta"]
+    assert got["xdd"] == ["x_ddot"]
