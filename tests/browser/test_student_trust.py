@@ -232,3 +232,44 @@ def test_the_answer_labels_of_each_kind_of_box(server, page):
     assert got["L"] == ["L"]
     assert got["eomTheta"] == ["EoM theta", "dL/dtheta_dot", "d/dt dL/dtheta_dot", "dL/dtheta"]
     assert got["xdd"] == ["x_ddot"]
+
+
+# Every line of a provenance table's words (its header, caption and the origin of each term) that
+# reaches past the derivation column's right edge, with its font size.
+PAST_THE_COLUMN = """() => {
+  const out = [];
+  const column = document.querySelector("#steps").getBoundingClientRect();
+  const words = ".pv-table caption, .pv-table th, .pv-table .pv-origin, .pv-table .pv-piece";
+  for (const el of document.querySelectorAll(words)) {
+    if (el.offsetParent === null || !el.textContent.trim()) continue;
+    const range = document.createRange();
+    range.selectNodeContents(el);
+    const right = Math.max(...[...range.getClientRects()].map((r) => r.right));
+    const size = parseFloat(getComputedStyle(el).fontSize);
+    const text = el.textContent.trim().slice(0, 50);
+    if (right > column.right + 1 || size < 24) out.push([text, right, size]);
+  }
+  return out;
+}"""
+
+
+@pytest.mark.parametrize("width, height", [(1024, 768), (1280, 720)])
+def test_lecture_modes_provenance_words_wrap_in_the_column(server, page, sized, width, height):
+    """Lecture mode at a projector's size: the provenance tables' words (the f table's header
+    'right side minus the left side's terms free of q̈', each term's origin) wrap inside the
+    derivation's column at lecture size (24 px), where they ran past its edge in a table wider
+    than the column."""
+    p = page.page
+    sized(width, height)
+    p.goto(f"{server}/scenes/double_pendulum?lecture=1")
+    p.wait_for_function("() => document.getElementById('steps').dataset.typeset === '1'")
+    n = p.locator("#steps > .step").count()
+    for _ in range(n):
+        p.keyboard.press("ArrowRight")
+    p.wait_for_selector(".pv-panel")
+    p.eval_on_selector_all(".pv-panel", "ds => ds.forEach((d) => { d.open = true; })")
+    p.wait_for_function("() => document.querySelectorAll('.pv-table .pv-origin').length > 0")
+    p.wait_for_timeout(300)
+    header = p.locator(".pv-table th", has_text="right side minus").first
+    assert header.is_visible()
+    assert p.evaluate(PAST_THE_COLUMN) == []
