@@ -67,6 +67,9 @@ class Root:
     how: str = "closed form"
     #: The same conditions as ``exists``, in LaTeX for the page (empty when always).
     exists_latex: str = ""
+    #: How many independent directions of equilibria pass through it (a family), and in words.
+    family_dim: int = 0
+    family: str = ""
 
 
 @dataclass
@@ -80,6 +83,10 @@ class Verdict:
     modes: list[list[float]]
     phases: list[list[float]]
     linear: dict | None
+    #: Each eigenvalue's eigenvector, its displacement half (δq in the coordinates kept).
+    vectors: list[np.ndarray] = field(default_factory=list)
+    #: The family of equilibria it belongs to, in words (empty: an isolated point).
+    family: str = ""
 
     @property
     def stable(self) -> bool:
@@ -100,11 +107,17 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     """Steps in the notes' order and every equilibrium at the given parameter values."""
     m = d.model
     values = {m.params[k]: sp.Float(v) for k, v in _checked(d, parameters or {}).items()}
-    conditions = _once(
+    general = _once(
         d, "at rest", "", lambda: _at_rest(Variant(m, d.work.mass_matrix, d.work.forcing, []))
     )
-    steps = [_virtual_work_step(d, conditions)]
+    steps = [_virtual_work_step(d, general)]
     warnings: list[str] = []
+    # Parameters that are 0 here are set to 0 exactly before anything is evaluated: the general
+    # forces can hold 0/0 that cancels then (a spring's k (ℓ − ℓ₀) d/ℓ with ℓ₀ = 0 at its anchor)
+    # and 0·∞ (k ℓ₀/ℓ with k = 0): numbers alone called the anchor 'no equilibrium'.
+    zeros = tuple(sorted((p for p, x in values.items() if float(x) == 0), key=str))
+    base = _once(d, "zeroed", zeros, lambda: _zeroed(d, zeros))
+    conditions = _once(d, "at rest", zeros, lambda: _at_rest(base)) if zeros else general
     conditions = [_drop_idle_drive(d, c, values) for c in conditions]
     if any(explicit_time(c, m) for c in conditions):
         warnings.append(
@@ -114,18 +127,24 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         return {"steps": [s.to_json() for s in steps], "equilibria": [], "warnings": warnings}
     periods = _once(d, "periods", "", lambda: _periods(d))
     found: list[tuple[Derivation, Root]] = []
-    variants, notes = _once(d, "variants", "", lambda: _variants(d))
+    everywhere = Variant(m, d.work.mass_matrix, d.work.forcing, [])
+    if len(_once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]) > 1:
+        # the step shows every side's conditions as derived, whatever is 0 at these values
+        for variant in _once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]:
+            conds = _once(d, "at rest", ((), variant.label), functools.partial(_at_rest, variant))
+            steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
+    variants, notes = _once(d, "variants", zeros, lambda: _variants(d, base, zeros))
     warnings += notes
-    idle = _idle_at(m, conditions, values)
+    idle = _idle_at(m, [_drop_idle_drive(d, c, values) for c in general], values)
+    families: list[str] = []
     if idle:
-        warnings.append(_idle_note(m, idle, len(idle) == len(m.q)))
+        families.append(_idle_note(m, idle, len(idle) == len(m.q)))
     for variant in variants:
         if variant.label and len(variants) > 1:
-            conds = _once(d, "at rest", variant.label, functools.partial(_at_rest, variant))
+            key = (zeros, variant.label)
+            conds = _once(d, "at rest", key, functools.partial(_at_rest, variant))
         else:
             conds = conditions
-        if len(variants) > 1:
-            steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
         conds = [_drop_idle_drive(d, c, values) for c in conds]
         conds = [sp.S.Zero if j in idle else c for j, c in enumerate(conds)]
         try:
@@ -160,7 +179,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         try:
             with np.errstate(all="ignore"):
-                verdict = _stability(variant, q0, free, values)
+                verdict = _stability(variant, q0, free, values, root.family_dim)
         except (_BeyondDoubles, np.linalg.LinAlgError, OverflowError) as exc:
             raise _beyond_doubles(d, parameters or {}, q0, exc) from None
         except ValueError:  # sympy cannot differentiate the forces here: sign(q̇) at q̇ = 0
@@ -175,11 +194,13 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 "is left out."
             )
             continue
+        verdict.family = root.family
         verdicts.append(verdict)
         results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
+    families += [v.family for v in verdicts if v.family and v.family not in families]
     steps.append(_stability_step(results, verdicts))
     dry = _once(d, "dry friction", "", lambda: _dry_friction(d))
     if dry:
@@ -189,7 +210,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             "rest stays at rest wherever static friction can hold the other forces (|F| ≤ μN)"
             + (": the scene's stop conditions say where." if m.spec.stops else ".")
         )
-    if not results and not dry:
+    if results:  # a family is said only where one of its members is listed
+        warnings[:0] = families
+    elif not dry and not any(w.startswith(_EDGE) for w in warnings):
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
 
@@ -221,19 +244,46 @@ def _undefined_position(m: Any, q0: list[float], values: dict) -> str | None:
 
 def _idle_at(m: Any, conditions: list[sp.Expr], values: dict) -> list[int]:
     """Coordinates whose force at rest vanishes for every value of them at these parameters
-    (a pendulum's Q_θ = −m g l sin θ with g = 0) and that no other condition holds: every value
-    is an equilibrium. Searched for points, the family came out as a score of sampled 'marginal'
-    equilibria and a note that sympy had missed them. Only a zero parameter can do this to a
-    condition that is not 0 for all parameters, so the check costs nothing otherwise."""
-    if not any(float(v) == 0 for v in values.values()):  # sympy: Float(0.0) != 0
-        return []
+    (a pendulum's Q_θ = −m g l sin θ with g = 0; an Atwood machine's Q_x = (m₁ − m₂) g with
+    m₁ = m₂) and that no other condition holds: every value is an equilibrium. Searched for
+    points, the family came out as a score of sampled 'marginal' equilibria ('a continuum?')."""
     at = [c.xreplace(values) for c in conditions]
     zero = [
         j
         for j, (c, a) in enumerate(zip(conditions, at, strict=True))
-        if c != 0 and (a == 0 or a.is_zero is True)
+        if c != 0 and _vanishes(c, a, values)
     ]
     return [j for j in zero if not any(a.has(m.q[j]) for a in at)]
+
+
+def _vanishes(c: sp.Expr, at: sp.Expr, values: dict) -> bool:
+    """Is the condition c, at these values (``at``), zero whatever the coordinates? A number
+    left over is judged against its terms' sizes: m₁ g − m₂ g with m₁ = m₂ is 0 up to rounding."""
+    if at == 0 or at.is_zero is True:
+        return True
+    if at.free_symbols or not at.is_number:
+        return False
+    try:
+        size = sum(abs(complex(a.xreplace(values))) for a in sp.Add.make_args(sp.expand(c)))
+        return abs(complex(at)) <= 1e-12 * size
+    except (TypeError, ValueError):
+        return False
+
+
+def _zeroed(d: Derivation, zeros: tuple) -> Variant:
+    """M and the forcing with the parameters in ``zeros`` set to 0 exactly (once per such set):
+    k (ℓ − ℓ₀) d/ℓ becomes k d, a smooth force through the anchor. An entry that the 0 would
+    make infinite (1/ℓ with ℓ = 0) is left as derived, for the numbers to judge as before."""
+    m, w = d.model, d.work
+    if not zeros:
+        return Variant(m, w.mass_matrix, w.forcing, [])
+    to_zero = {p: sp.S.Zero for p in zeros}
+
+    def zeroed(e: sp.Expr) -> sp.Expr:
+        out = e.xreplace(to_zero)
+        return e if out.has(sp.zoo, sp.nan, sp.oo, -sp.oo) else out
+
+    return Variant(m, w.mass_matrix.applyfunc(zeroed), w.forcing.applyfunc(zeroed), [])
 
 
 def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
@@ -241,8 +291,8 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
     if everything:
         return (
             "No force acts at rest at these parameters (every Q_j vanishes at q̇ = 0): every "
-            "configuration is an equilibrium, and each is neutral: a nudge starts a drift at "
-            "constant speed, nothing pulls it back. The list shows one of them."
+            "configuration is an equilibrium (a family), none held by a restoring force: the "
+            "list shows one of them, and what a nudge does there."
         )
     return (
         f"At these parameters no force acts at rest along {names} (its Q vanishes for every "
@@ -511,10 +561,18 @@ class Variant:
     label: str = ""
 
 
-def _variants(d: Derivation) -> tuple[list[Variant], list[str]]:
-    """Every side of every spring's anchor (bounded), with a note when not all were searched."""
-    m, w = d.model, d.work
-    springs = [s for s in m.springs if getattr(s, "branch", None) is not None]
+def _variants(d: Derivation, base: Variant, zeros: tuple) -> tuple[list[Variant], list[str]]:
+    """Every side of every spring's anchor (bounded), with a note when not all were searched.
+
+    A spring whose rest length is 0 here has no sides: ½k p² is smooth through its anchor, where
+    it rests when nothing else pulls (its range p > 0 had left that equilibrium out)."""
+    m = d.model
+    to_zero = {p: sp.S.Zero for p in zeros}
+    springs = [
+        s
+        for s in m.springs
+        if getattr(s, "branch", None) is not None and s.rest_length.xreplace(to_zero) != 0
+    ]
     variants, warnings = [], []
     for flips in itertools.product((False, True), repeat=len(springs)):
         if len(variants) >= MAX_BRANCH_VARIANTS:
@@ -523,7 +581,7 @@ def _variants(d: Derivation) -> tuple[list[Variant], list[str]]:
                 "for equilibria."
             )
             break
-        forcing, ranges, where = w.forcing, [], []
+        forcing, ranges, where = base.forcing, [], []
         for s, flip in zip(springs, flips, strict=True):
             p = -s.branch if flip else s.branch
             if flip:
@@ -531,7 +589,7 @@ def _variants(d: Derivation) -> tuple[list[Variant], list[str]]:
                 forcing = forcing - extra
             ranges.append(p)
             where.append(f"{s.name}: ℓ = {to_plain(p)}")
-        variants.append(Variant(m, w.mass_matrix, forcing, ranges, ", ".join(where)))
+        variants.append(Variant(m, base.mass_matrix, forcing, ranges, ", ".join(where)))
     return variants, warnings
 
 
@@ -547,6 +605,9 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
         return [Root({}, {}, "always")], notes
     to_zero = {m.q[j]: 0 for j in free}
     eqs = [conditions[j].xreplace(to_zero) for j in bound]
+    family = _linear_family(m, eqs, bound, values)
+    if family is not None:
+        return [family], notes
     system = _System(v, eqs, bound, values, periods)
     symbolic = _symbolic(m, eqs, bound, values, periods)
     numeric = _numeric_search(system)
@@ -598,7 +659,84 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
             f"The numeric search stopped at its time limit ({SEARCH_SECONDS:g} s): "
             "equilibria may be missing."
         )
+    notes += [_edge_note(m, edge) for edge in system.edges if not roots]
     return roots, notes
+
+
+_EDGE = "The forces balance only at"
+
+
+def _edge_note(m: Any, edge: dict[int, float]) -> str:
+    """Forces that balance only where a declared-positive coordinate is 0 (an elastic pendulum
+    with ℓ₀ = 0 and g = 0 rests at its anchor, r = 0): the state exists, its coordinates do not."""
+    names = [
+        m.coordinate_names[j] for j in edge if m.coordinate_names[j] in m.spec.positive_coordinates
+    ]
+    at = ", ".join(f"{m.coordinate_names[j]} = {x:.4g}" for j, x in edge.items())
+    return (
+        f"{_EDGE} {at}, on the edge of the coordinates ({', '.join(names)} is "
+        "declared positive: the coordinates are singular where it is 0, e.g. a polar angle "
+        "loses its meaning at the origin). The system can rest there, but these coordinates "
+        "cannot linearize about it, so it is not listed."
+    )
+
+
+def _linear_family(m: Any, eqs: list[sp.Expr], bound: list[int], values: dict) -> Root | None:
+    """Conditions that are linear in the coordinates at these values (A q = b) but of rank
+    below their number, and consistent: a family of equilibria, q* + span(null A), such as
+    two masses coupled only to each other (x₁ = x₂, any value). Returned as one Root, the
+    point nearest q = 0, with the family's dimension and its description; None otherwise,
+    for the search to find points. Searched for points, the family came out as two dozen
+    sampled 'marginal' equilibria and 'a continuum?'."""
+    qs = [m.q[j] for j in bound]
+    at = [e.xreplace(values) for e in eqs]
+    try:
+        if not all(a.is_polynomial(*qs) and sp.Poly(a, *qs).total_degree() <= 1 for a in at):
+            return None
+        A = np.array([[float(a.diff(q)) for q in qs] for a in at])
+        b = -np.array([float(a.xreplace(dict.fromkeys(qs, 0))) for a in at])
+    except (TypeError, ValueError, sp.PolynomialError):
+        return None
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        return None
+    u, sv, vt = np.linalg.svd(A)
+    scale = float(np.max(np.abs(sv), initial=0.0))
+    rank = int(np.sum(sv > 1e-10 * scale)) if scale > 0 else 0
+    if rank == len(qs):
+        return None  # one point: sympy's closed form says it better
+    x = np.linalg.pinv(A, rcond=1e-10) @ b if rank else np.zeros(len(qs))
+    size = float(np.max(np.abs(b), initial=0.0)) + scale * float(np.max(np.abs(x), initial=0))
+    if np.max(np.abs(A @ x - b), initial=0.0) > 1e-9 * max(size, 1e-300):
+        return None  # inconsistent: no equilibrium, which the search finds too
+    x = np.where(np.abs(x) <= 1e-12 * max(1.0, float(np.max(np.abs(x)))), 0.0, x)
+    null = vt[rank:]
+    names = [m.coordinate_names[j] for j in bound]
+    directions = []
+    for v in null:
+        v = v / v[np.argmax(np.abs(v))]
+        v = np.where(np.abs(v) < 1e-12, 0.0, v)
+        directions.append("(" + ", ".join(f"{c:.4g}" for c in v + 0.0) + ")")
+    point = "(" + ", ".join(f"{c:.4g}" for c in x + 0.0) + ")"
+    dim = len(null)
+    s = "" if dim == 1 else "s"
+    description = (
+        f"At these parameters the conditions are linear in {', '.join(names)} and only {rank} "
+        f"of the {len(qs)} are independent: the equilibria form a {dim}-parameter family, "
+        f"({', '.join(names)}) = {point} + "
+        + " + ".join(f"s{k + 1} {d}" for k, d in enumerate(directions))
+        + f" for any s{'' if dim == 1 else '1…s' + str(dim)} (a line of equilibria"
+        + ("" if dim == 1 else ", or a plane")
+        + f"). The list shows the one nearest 0; along the family direction{s} no force acts, "
+        "so a nudge there drifts on (neutral)."
+    )
+    return Root(
+        dict(zip(bound, (float(c) for c in x), strict=True)),
+        {},
+        "always",
+        "linear conditions: a family",
+        family_dim=dim,
+        family=description,
+    )
 
 
 @dataclass(frozen=True)
@@ -750,6 +888,8 @@ class _System:
         self.bound = bound
         self.periods = [periods.get(j) for j in bound]
         ranges = [m.q[j] for j in bound if m.coordinate_names[j] in m.spec.positive_coordinates]
+        self.positive = len(ranges)  # the first ranges: declared-positive coordinates
+        self.edges: list[dict[int, float]] = []
         ranges += v.ranges
         psyms = tuple(sorted(values, key=str))
         f, jac, scale, in_range = _conditions_numeric(
@@ -775,6 +915,17 @@ class _System:
     def in_range(self, X: np.ndarray) -> np.ndarray:
         R = self.ranges(X)
         return np.all(R > 1e-9, axis=0) if len(R) else np.ones(X.shape[1], dtype=bool)
+
+    def on_edge(self, X: np.ndarray) -> np.ndarray:
+        """Columns of X at 0 of a declared-positive coordinate and inside every other range."""
+        R = self.ranges(X)
+        if not self.positive:
+            return np.zeros(X.shape[1], dtype=bool)
+        edge = np.any(np.abs(R[: self.positive]) <= 1e-9, axis=0)
+        others = np.all(R[: self.positive] > -1e-9, axis=0) & np.all(
+            R[self.positive :] > 1e-9, axis=0
+        )
+        return edge & others
 
 
 @functools.lru_cache(maxsize=512)
@@ -854,7 +1005,11 @@ def _numeric_search(system: _System) -> list[list[float]]:
             break
     alive = np.all(np.isfinite(X), axis=0)
     X = X[:, alive]
-    X = X[:, system.residual_ok(X) & system.in_range(X)]
+    balanced = system.residual_ok(X)
+    edge = balanced & ~system.in_range(X) & system.on_edge(X)
+    for x in X[:, edge].T[:1]:
+        system.edges.append(dict(zip(system.bound, (float(v) + 0.0 for v in x), strict=True)))
+    X = X[:, balanced & system.in_range(X)]
     found: list[list[float]] = []
     for x in X.T:
         x = [_wrap(float(v), p)[0] + 0.0 for v, p in zip(x, system.periods, strict=True)]
@@ -933,13 +1088,16 @@ def _derivative(expr: sp.Expr, var: sp.Expr) -> sp.Expr:
     return expr.diff(var)
 
 
-def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Verdict:
+def _stability(
+    v: Variant, q0: list[float], free: list[int], values: dict, family_dim: int = 0
+) -> Verdict:
     """M δq̈ + C δq̇ + K δq = 0 with K = −∂f/∂q, C = −∂f/∂q̇ at rest; the eigenvalues λ of the
     first-order system decide (δq ∝ e^{λt}), and why is put in words.
 
     Every coordinate takes part (a free cart still moves with its pendulum), except one whose
     mass-matrix row vanishes there: a coordinate singularity such as φ at the pole of a sphere.
-    Zero eigenvalues are neutral along free (cyclic) coordinates, undecided otherwise.
+    Zero eigenvalues are neutral along free (cyclic) coordinates and along the ``family_dim``
+    directions of a family of equilibria through q0, undecided otherwise.
     """
     m = v.model
     n = len(m.q)
@@ -974,13 +1132,98 @@ def _stability(v: Variant, q0: list[float], free: list[int], values: dict) -> Ve
     if not all(np.all(np.isfinite(x)) for x in (M, C, K)):
         raise _BeyondDoubles
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
-    n_free = len([j for j in free if j in idx])
+    n_free = len([j for j in free if j in idx]) + family_dim
     names = [m.coordinate_names[j] for j in idx]
     kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m))
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
-    return Verdict(kind, reason, list(lam), freqs, modes, phases, linear)
+    vectors = [vecs[: len(idx), i] for i in range(len(lam))]
+    verdict = Verdict(kind, reason, list(lam), freqs, modes, phases, linear, vectors)
+    lost = [j for j in range(n) if j not in idx]
+    if lost:
+        _at_a_pole(verdict, m, full_M, at_rest, q0, numbers if at_rest else [], idx, lost, free)
+    return verdict
+
+
+def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> None:
+    """q0 is a coordinate singularity: the rows of M of the coordinates in ``lost`` vanish here
+    (φ at θ = 0 of a sphere), so the linearization above is in the others only, and one
+    direction of motion is missing from it. The bob at the bottom of a spherical pendulum swings
+    in any vertical plane: two modes of equal ω = √(g/l), where θ alone shows one.
+
+    Where the lost coordinate is cyclic (a symmetry turns the system about the pole) and no
+    velocity-linear term acts (C = 0: nothing tells one sense of turning from the other), the
+    directions that bring the lost coordinate back to life (M_φφ grows like θ² away from the
+    pole: θ 'radial') form with it a plane in which the motion is isotropic: each eigenvalue and
+    mode that moves a radial coordinate comes twice. Otherwise the missing modes are unknown,
+    and the verdict says so rather than show a short list."""
+    lost_names = ", ".join(m.coordinate_names[j] for j in lost)
+    where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
+    pole = (
+        f"{where} is a pole of the coordinates: the row of M for {lost_names} vanishes there "
+        f"(every {lost_names} names the same point), so the linearization is in "
+        f"{', '.join(m.coordinate_names[j] for j in idx)} alone"
+    )
+    radial = _radial(m, full_M, at_rest, q0, numbers, idx, lost)
+    cyclic = all(j in free for j in lost)
+    C = verdict.linear["C"] if verdict.linear else None
+    if not cyclic:
+        # V depends on the lost coordinate: the other directions off the pole were not tested
+        verdict.reason += (
+            f"; {pole}: only the directions off it along {lost_names} = its value here were "
+            "tested, the others cannot be in these coordinates, so the list of modes may be "
+            "incomplete"
+        )
+        if verdict.kind in STABLE_KINDS:
+            verdict.kind = "marginal"
+            verdict.reason += " and the linear test cannot decide"
+        return
+    if not radial or C is None or np.any(np.abs(C) > 0):
+        verdict.reason += (
+            f"; {pole}: the modes that turn about it are not found in these coordinates (a "
+            "velocity-linear force can split them), so the list of modes may be incomplete"
+        )
+        return
+    columns = [idx.index(j) for j in radial]
+    twins = [
+        z
+        for z, vec in zip(verdict.eigenvalues, verdict.vectors, strict=True)
+        if np.max(np.abs(vec[columns])) > 1e-9 * max(1.0, float(np.max(np.abs(vec))))
+    ]
+    modes = list(zip(verdict.frequencies, verdict.modes, verdict.phases, strict=True))
+    modes += [
+        (f, mode, phase) for f, mode, phase in modes if max(abs(mode[j]) for j in radial) > 1e-9
+    ]
+    modes.sort(key=lambda fmp: fmp[0])
+    verdict.eigenvalues = _eigen_sorted(np.array([*verdict.eigenvalues, *twins]))
+    verdict.frequencies = [f for f, _, _ in modes]
+    verdict.modes = [mode for _, mode, _ in modes]
+    verdict.phases = [phase for _, _, phase in modes]
+    radial_names = ", ".join(m.coordinate_names[j] for j in radial)
+    verdict.reason += (
+        f"; {pole}. About the pole the motion is in a plane ({radial_names} in any direction "
+        f"{lost_names}), and by the symmetry in {lost_names} each motion of {radial_names} "
+        f"comes twice: two degenerate modes, the second the same motion turned by a quarter "
+        f"turn of {lost_names}, which these coordinates cannot tell apart here"
+    )
+
+
+def _radial(m, full_M, at_rest, q0, numbers, idx, lost) -> list[int]:
+    """The coordinates that move the system off the pole: M_φφ grows like their square."""
+    if at_rest is None:
+        return []
+    inertia = float(np.max(np.abs(np.diag(full_M)), initial=0.0))
+    n, out = len(q0), []
+    for i in idx:
+        h = 1e-2
+        point = list(q0)
+        point[i] += h
+        with np.errstate(all="ignore"):
+            M_h = np.array(at_rest(*point, *numbers)[0], dtype=float).reshape(n, n)
+        if all(abs(M_h[j, j]) > 1e-9 * inertia for j in lost):
+            out.append(i)
+    return out
 
 
 def _turning(m: Any) -> bool:
@@ -996,7 +1239,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
     n = len(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam, vecs = np.linalg.eig(A)
-    order = np.lexsort((-lam.imag, -lam.real))
+    order = _eigen_order(lam)
     lam, vecs = lam[order], vecs[:, order]
     scale = max(1.0, float(np.max(np.abs(lam))))
     tol = 1e-7 * scale
@@ -1033,12 +1276,27 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         return "unstable", reason, lam, vecs
     zero = np.abs(lam) <= 1e-6 * scale
     if n_free == n:
+        # what a nudge does without a restoring force depends on the velocity-linear terms
+        if gyroscopic:
+            nudge = (
+                "the Coriolis (gyroscopic) terms turn a nudge in velocity into a bounded loop, "
+                "not a drift, but K is singular in every direction and nonlinear terms decide "
+                "(neutral at best)"
+            )
+        elif damped:
+            nudge = (
+                "damping brings a nudge in velocity to rest at a nearby point, and nothing "
+                "pulls it back (neutral, not stable)"
+            )
+        else:
+            nudge = (
+                "a nudge in velocity drifts on without a force pulling it back (neutral, not "
+                "stable)"
+            )
         return (
             "marginal",
             "every coordinate is free: no force acts at rest in any direction (K = 0), so every "
-            "nearby configuration is an equilibrium too, and a nudge in velocity drifts on "
-            "without a force pulling it back (neutral, not stable; eigenvalues "
-            f"{shown})",
+            f"nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
             lam,
             vecs,
         )
@@ -1052,8 +1310,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
             vecs,
         )
     free_note = (
-        "; the zero eigenvalues belong to the free coordinate(s), which stay where they are "
-        "put (a family of equilibria)"
+        "; the zero eigenvalues belong to the free direction(s), along which the system stays "
+        "where it is put (a family of equilibria) and a nudge drifts on (neutral)"
         if np.any(zero)
         else ""
     )
@@ -1068,6 +1326,11 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         )
     if k_pd_off_free and c_psd:
         reason = f"K is positive definite, so the {_potential(turning)} has a minimum here"
+        if n_free:  # K is singular along the free directions: definite only off them
+            reason = (
+                f"K is positive definite off the {n_free} free direction(s), so the "
+                f"{_potential(turning)} has a minimum across them"
+            )
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
             reason = (
                 "K is positive definite, so the potential (with the centrifugal term where a "
@@ -1103,6 +1366,28 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         lam,
         vecs,
     )
+
+
+def _eigen_order(lam: np.ndarray) -> list[int]:
+    """The order the eigenvalues are listed in, the frequencies' order: the non-oscillating
+    ones first (largest real part first), then each conjugate pair together (+i before −i) by
+    ascending |Im λ| = ω. Sorted by real part first, an elastic pendulum listed ±6.325i before
+    ±2.807i beside ω = 2.807, 6.325. Values within rounding of each other count as equal."""
+    scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
+    tol = 1e-7 * scale
+
+    def key(i: int) -> tuple:
+        z = lam[i]
+        omega = abs(z.imag)
+        if omega <= tol:
+            return (0, 0.0, -round(z.real / tol), 0)
+        return (1, round(omega / tol), -round(z.real / tol), 0 if z.imag > 0 else 1)
+
+    return sorted(range(len(lam)), key=key)
+
+
+def _eigen_sorted(lam: np.ndarray) -> list[complex]:
+    return [complex(lam[i]) for i in _eigen_order(lam)]
 
 
 def _potential(turning: bool) -> str:
@@ -1179,10 +1464,13 @@ def _z(z: complex) -> str:
 def _eigen_text(lam: np.ndarray) -> str:
     """λ, each conjugate pair once as a ± b i, and the imaginary-axis ones as ±b i."""
     parts = []
+    scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
     for z in lam:
         if z.imag < -1e-12:
             continue
-        if abs(z.imag) <= 1e-12:
+        if abs(z) <= 1e-9 * scale:
+            parts.append("0")  # round-off of a zero eigenvalue: −9.7e-17 said nothing
+        elif abs(z.imag) <= 1e-12:
             parts.append(f"{z.real:.4g}")
         elif abs(z.real) <= 1e-9 * max(1.0, abs(z)):
             parts.append(f"±{z.imag:.4g}i")
@@ -1225,7 +1513,8 @@ def _stability_step(results: list[dict], verdicts: list[Verdict]) -> Step:
     )
     lines = []
     for r, v in zip(results, verdicts, strict=True):
-        q = ", ".join(f"{k} = {x:.4g}" for k, x in r["q"].items())
+        # a free coordinate is 'any φ', as the panel says it: 'φ = 0' named one of the family
+        q = ", ".join(f"any {k}" if k in r["free"] else f"{k} = {x:.4g}" for k, x in r["q"].items())
         if v.linear is not None:
             linear = v.linear
             lines.append(
