@@ -79,7 +79,7 @@ MATH_WORDS = frozenset(
     | {"lt", "gt", "le", "ge", "to", "mapsto", "circ", "displaystyle", "limits", "nabla"}
     | {"lvert", "rvert", "lVert", "rVert", "langle", "rangle", "lfloor", "rfloor", "lceil"}
     | {"rceil", "max", "min", "sgn", "mod", "operatorname", "Re", "Im", "in", "propto"}
-    | {"Rightarrow", "leftarrow", "surd"}
+    | {"Rightarrow", "leftarrow", "surd", "det"}
 )
 #: Environments an equation may open (sympy's matrices, piecewise's cases).
 MATH_ENVIRONMENTS = frozenset({"matrix", "pmatrix", "bmatrix", "smallmatrix", "cases", "array"})

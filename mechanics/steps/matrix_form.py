@@ -30,10 +30,8 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
         Line("M", rf"\mathbf{{M}} = {to_latex(M)}", f"M = {to_plain(M.tolist())}"),
         Line("f", rf"\mathbf{{f}} = {to_latex(f)}", f"f = {to_plain(f.T.tolist()[0])}"),
     ]
-    text = (
-        r"Collect the $\ddot q$ terms: $\mathbf M(q, t)\,\ddot q = \mathbf f(q, \dot q, t)$; "
-        r"$\mathbf M$ is symmetric and positive definite."
-    )
+    text = r"Collect the $\ddot q$ terms: $\mathbf M(q, t)\,\ddot q = \mathbf f(q, \dot q, t)$. "
+    det = None
     if n <= SOLVE_MAX_COORDINATES:
         size = sp.count_ops([*M, *f])
         if size > SOLVE_OPS_BUDGET:
@@ -42,21 +40,60 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
                 f"budget of {SOLVE_OPS_BUDGET}; the simulation solves M q̈ = f numerically"
             )
         else:
-            work.accelerations = solve_accelerations(M, f, model)
-            for name, qdd, acc in zip(
-                model.coordinate_names, model.qdd, work.accelerations, strict=True
-            ):
-                lines.append(eq_line(f"{name}_ddot", to_latex(qdd), acc, f"{name}_ddot"))
-            text += r" Solved for $\ddot q$ (Cramer's rule, each piece simplified):"
+            det = determinant(M, model)
+    text += definiteness(det, model)
+    if det is not None:
+        work.accelerations = solve_accelerations(M, f, model, det)
+        for name, qdd, acc in zip(
+            model.coordinate_names, model.qdd, work.accelerations, strict=True
+        ):
+            lines.append(eq_line(f"{name}_ddot", to_latex(qdd), acc, f"{name}_ddot"))
+        text += r" Solved for $\ddot q$ (Cramer's rule, each piece simplified):"
     return Step("matrix", "Mass-matrix form", text, lines)
 
 
-def solve_accelerations(M: sp.Matrix, f: sp.Matrix, model: Model) -> list[sp.Expr]:
+def determinant(M: sp.Matrix, model: Model) -> sp.Expr:
+    return tidy(M.det(method="berkowitz"), model, collect_velocities=False)
+
+
+def definiteness(det: sp.Expr | None, model: Model) -> str:
+    """What the step may say of M: T ≥ 0 makes it positive semidefinite everywhere, but only a
+    nonzero det M makes it definite, and spherical or polar coordinates lose that at their poles
+    (a spherical pendulum's det M = l⁴m² sin²θ), where q̈ is not defined."""
+    if det is not None and _positive(det, model):
+        return (
+            r"$\mathbf M$ is symmetric and positive definite at every configuration: "
+            rf"$\det \mathbf M = {to_latex(det)} > 0$ for positive masses and lengths."
+            if len(to_latex(det)) <= 200
+            else r"$\mathbf M$ is symmetric and positive definite at every configuration "
+            r"($\det \mathbf M > 0$ for positive masses and lengths)."
+        )
+    where = (
+        rf"$\det \mathbf M = {to_latex(det)} \neq 0$"
+        if det is not None and len(to_latex(det)) <= 200
+        else r"$\det \mathbf M \neq 0$"
+    )
+    return (
+        r"$\mathbf M$ is symmetric and positive semidefinite (as $T \ge 0$); it is positive "
+        rf"definite, so that $\ddot q$ is defined, wherever {where}."
+    )
+
+
+def _positive(det: sp.Expr, model: Model) -> bool:
+    """det M > 0 for every real configuration and time, the nonnegative parameters (masses,
+    lengths) taken positive: sympy's assumptions decide it, or it is not claimed."""
+    t = model.names["t"]
+    real = {qi: sp.Dummy(real=True, positive=qi.is_positive or None) for qi in model.q}
+    positive = {p: sp.Dummy(positive=True) for p in det.free_symbols if p.is_nonnegative}
+    value = det.subs(real).subs({t: sp.Dummy(real=True), **positive})
+    return value.is_positive is True
+
+
+def solve_accelerations(M: sp.Matrix, f: sp.Matrix, model: Model, det: sp.Expr) -> list[sp.Expr]:
     """Cramer's rule with a simplified determinant: small pieces instead of simplify(M⁻¹f)."""
     n = M.shape[0]
     if n == 1:
         return [ratio(f[0], M[0, 0], model)]
-    det = tidy(M.det(method="berkowitz"), model, collect_velocities=False)
     out = []
     for i in range(n):
         Mi = M.copy()
