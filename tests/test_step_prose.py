@@ -61,3 +61,26 @@ def test_a_scenes_summary_reads_as_prose(scene_id):
     summary = load_scene(scene_id)["summary"]
     assert not PSEUDO_MATH.search(summary), summary
     assert not re.search(r"\b(theta|phi|alpha|Omega|omega|x_ddot|_dot)\b", summary), summary
+
+
+@pytest.mark.parametrize(
+    ("scene_id", "weight", "springs"),
+    [
+        ("simple_pendulum", True, False),
+        ("spring_mass_damper", False, True),
+        ("elastic_pendulum", True, True),
+        ("central_force", False, False),
+    ],
+)
+def test_the_datum_names_only_what_the_scene_has(scene_id, weight, springs):
+    """A scene without gravity has no heights to measure V from, and draws no weight: the
+    free-body step says so instead of leaving a student to look for the missing mg."""
+    from mechanics.scenes import load_scene
+
+    spec = load_scene(scene_id)
+    assert (spec.get("gravity") is not None) == weight  # the scene as written
+    assert bool(spec.get("springs")) == springs
+    text = next(s.text for s in derivation_of(scene_id, None).steps if s.id == "fbd")
+    assert ("height of O" in text) == weight
+    assert ("rest length" in text) == springs
+    assert ("no uniform gravity" in text) == (not weight)

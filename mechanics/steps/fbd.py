@@ -457,9 +457,13 @@ def free_body_diagram(model: Model, work: Work) -> Step:
                 rf"\vec{{\omega}}_{{{name}/N}}", w, name, model, f"angular velocity of frame {name}"
             )
         )
-    datum = "V = 0 with every body at the height of O"
-    if model.springs:
-        datum += " and every spring at its rest length"
+    heights = "every body at the height of O" if model.gravity is not None else ""
+    rest = "every spring at its rest length" if model.springs else ""
+    datum = (
+        f"$V = 0$ with {' and '.join(filter(None, [heights, rest]))}"
+        if heights or rest
+        else "$V$ as the scene's potentials give it"
+    )
     text = (
         "Draw every force on every body, the constraint forces where they act. Weights, springs "
         "and potentials are conservative and enter through $V$; dampers and applied forces do "
@@ -467,6 +471,11 @@ def free_body_diagram(model: Model, work: Work) -> Step:
         "forces on all bodies together do no virtual work (notes eq. 18–20); on one body alone "
         f"only when its constraints are its own. Datum: {datum}."
     )
+    if model.gravity is None:
+        text += (
+            r" There is no uniform gravity in this scene (no weight $m\vec g$ on any body), so "
+            "none is drawn."
+        )
     return Step(
         "fbd",
         "Free-body diagram",
