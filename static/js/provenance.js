@@ -129,7 +129,7 @@ function matrixTables(provenance) {
   const names = Object.keys(provenance.eom || {});
   const sum = (ids, sign = 1) => ids.map((id, k) => {
     const tex = byId.get(id)?.latex ?? "?";
-    return (sign < 0 ? "- " : k ? "+ " : "") + (sign < 0 ? `\left(${tex}\right)` : tex);
+    return (sign < 0 ? "- " : k ? "+ " : "") + (sign < 0 ? String.raw`\left(${tex}\right)` : tex);
   }).join(" ");
   const entry = (label, ids, terms) => {
     const body = el("tbody", { className: "pv-term", tabIndex: 0 });

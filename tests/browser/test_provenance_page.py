@@ -44,6 +44,13 @@ def test_trace_terms_tables_and_hover(server, page, artifacts):
     assert p.locator("li[data-step=energy] .pv-panel").count() == 2
     assert p.locator("li[data-step=lagrange] .pv-panel").count() == 2
     assert p.locator(".pv-panel mjx-container").count() > 10  # typeset, not LaTeX source
+    # f's table subtracts terms as −\left(…\right): the TeX MathJax was given has no carriage
+    # return and no bare 'left(' (a template literal once turned '\r' of '\right' into one)
+    broken = p.evaluate(
+        """() => Array.from(MathJax.startup.document.math).map((m) => m.math)
+            .filter((tex) => /\\r|(?<!\\\\)left\\(/.test(tex))"""
+    )
+    assert broken == [], broken
     # The Coriolis term 2 m r ṙ θ̇ of the θ equation: from the ê_θ component, through d/dt ∂T/∂θ̇.
     [coriolis] = [
         t for t in prov["eom"]["theta"]["lhs"]["terms"] if t["plain"] == "2*m*r*r_dot*theta_dot"
