@@ -358,7 +358,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
                     f"{s.name}_at_anchor",
                     f"the spring {s.name} reaches zero length: its direction is undefined "
                     "there (V = ½k(|d| − ℓ₀)² has a corner), so the model ends",
-                    s.branch,
+                    _corner_only_if_stretched(s.branch, s.rest_length),
                 )
             )
     for name, qi in zip(spec.coordinates, q, strict=True):
@@ -392,6 +392,20 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         branches=chosen,
         stops=stops,
     )
+
+
+def _corner_only_if_stretched(branch: sp.Expr, rest_length: sp.Expr) -> sp.Expr:
+    """The anchor stop's value: the branch p while ℓ₀ ≠ 0, a constant 1 (never reached) when ℓ₀
+    is 0 in the run's parameters.
+
+    V = ½k(|p| − ℓ₀)² has a corner at p = 0 only for ℓ₀ ≠ 0: with ℓ₀ = 0 it is ½k p², smooth,
+    and the equations derived on either side (ℓ = ±p) are the same, −k p ∂p/∂q, so a body passes
+    straight through the anchor (an isotropic oscillator through its centre). A rest length that
+    is a parameter is only known at run time, hence the Piecewise rather than a choice here.
+    """
+    if rest_length.is_zero is False:
+        return branch
+    return sp.Piecewise((branch, sp.Ne(rest_length, 0)), (sp.S.One, True))
 
 
 def _unit(v: list[float] | None) -> tuple[float, float, float] | None:

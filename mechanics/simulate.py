@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import sympy as sp
 from scipy.integrate import cumulative_simpson
 
 from mechanics.divergence import compare_runs, worth_classifying
@@ -139,8 +140,10 @@ def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any)
     names = ", ".join(f"initial.{q}" for q in c.coordinates if q in req.initial) or "initial"
     flips = {}
     for i, fn in c.branch_values.items():
-        (p,) = _at(fn, 0.0, y0, n, params)
         spring = m.springs[i]
+        if _rest_length(c, spring, params) == 0:
+            continue  # ½k p² is smooth through the anchor, the same on either side: no branch
+        (p,) = _at(fn, 0.0, y0, n, params)
         # the scale of p: the coordinates it is made of (not an unrelated one's size)
         own = [abs(y0[j]) for j, q in enumerate(m.q) if spring.branch.has(q)]
         if not abs(p) > 1e-12 * max([1.0, *own]):
@@ -178,6 +181,16 @@ def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any)
 
 
 DIVISION_BY_ZERO = "division by zero"
+
+
+def _rest_length(c: CompiledScene, spring: Any, params: list[float]) -> float | None:
+    """A spring's rest length at these parameter values (None if it is not a number)."""
+    symbols = c.derivation.model.params
+    values = {symbols[k]: sp.Float(v) for k, v in zip(c.parameters, params, strict=True)}
+    try:
+        return float(spring.rest_length.xreplace(values))
+    except (TypeError, ValueError):
+        return None
 
 
 def _overflow(
