@@ -336,7 +336,8 @@ def _inside_the_model(m, results, verdicts, values, warnings):
         warnings.append(
             f"{len(out)} equilibri{'um' if len(out) == 1 else 'a'} of the equations "
             f"{'lies' if len(out) == 1 else 'lie'} where "
-            f"the model does not hold (past the stop {', '.join(names)}) and are left out."
+            f"the model does not hold (past the stop {', '.join(names)}) and "
+            f"{'is' if len(out) == 1 else 'are'} left out."
         )
     return [r for r, _, _ in kept], [v for _, v, _ in kept]
 
@@ -723,7 +724,7 @@ def _linear_family(m: Any, eqs: list[sp.Expr], bound: list[int], values: dict) -
         f"At these parameters the conditions are linear in {', '.join(names)} and only {rank} "
         f"of the {len(qs)} are independent: the equilibria form a {dim}-parameter family, "
         f"({', '.join(names)}) = {point} + "
-        + " + ".join(f"s{k + 1} {d}" for k, d in enumerate(directions))
+        + " + ".join(f"s{'' if dim == 1 else k + 1} {d}" for k, d in enumerate(directions))
         + f" for any s{'' if dim == 1 else '1…s' + str(dim)} (a line of equilibria"
         + ("" if dim == 1 else ", or a plane")
         + f"). The list shows the one nearest 0; along the family direction{s} no force acts, "
@@ -1161,9 +1162,8 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     lost_names = ", ".join(m.coordinate_names[j] for j in lost)
     where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
     pole = (
-        f"{where} is a pole of the coordinates: the row of M for {lost_names} vanishes there "
-        f"(every {lost_names} names the same point), so the linearization is in "
-        f"{', '.join(m.coordinate_names[j] for j in idx)} alone"
+        f"{where} is a pole of the coordinates ({lost_names} is undefined there: its row of M "
+        f"vanishes), so only {', '.join(m.coordinate_names[j] for j in idx)} was linearized"
     )
     radial = _radial(m, full_M, at_rest, q0, numbers, idx, lost)
     cyclic = all(j in free for j in lost)
@@ -1196,16 +1196,24 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
         (f, mode, phase) for f, mode, phase in modes if max(abs(mode[j]) for j in radial) > 1e-9
     ]
     modes.sort(key=lambda fmp: fmp[0])
+    before = _eigen_text(np.array(verdict.eigenvalues))
     verdict.eigenvalues = _eigen_sorted(np.array([*verdict.eigenvalues, *twins]))
+    verdict.reason = verdict.reason.replace(
+        f"eigenvalues {before})", f"eigenvalues {_eigen_text(np.array(verdict.eigenvalues))})"
+    )
     verdict.frequencies = [f for f, _, _ in modes]
     verdict.modes = [mode for _, mode, _ in modes]
     verdict.phases = [phase for _, _, phase in modes]
     radial_names = ", ".join(m.coordinate_names[j] for j in radial)
     verdict.reason += (
-        f"; {pole}. About the pole the motion is in a plane ({radial_names} in any direction "
-        f"{lost_names}), and by the symmetry in {lost_names} each motion of {radial_names} "
-        f"comes twice: two degenerate modes, the second the same motion turned by a quarter "
-        f"turn of {lost_names}, which these coordinates cannot tell apart here"
+        f"; {pole}. By the symmetry in {lost_names} each motion of {radial_names} comes twice, "
+        "in two perpendicular planes: "
+        + (
+            "it falls away in both, at the same rate"
+            if verdict.kind == "unstable"
+            else "two degenerate modes of equal ω"
+        )
+        + ", which these coordinates cannot tell apart at the pole"
     )
 
 

@@ -10,12 +10,43 @@ import { View } from "./view.js";
 
 const W = 150, H = 100;
 
+/** The badge's class per kind: marginal (neutral, undecided) has its own slate, not the
+ * unstable pink it wore before (a family of neutral equilibria read as a warning). */
+const KIND_CLASS = {
+  "stable": "stable", "asymptotically stable": "stable", "gyroscopically stable": "stable",
+  "marginal": "neutral", "unstable": "unstable",
+};
+/** The neutral badge's colours, set here because the page's stylesheet has no rule for it:
+ * slate #3b4a63 on #e8edf5 is 7.6:1 (AA needs 4.5:1 for its small type). */
+const NEUTRAL = { color: "#3b4a63", background: "#e8edf5" };
+
+/** The first time the panel says K (or C), what it is: the reasons speak of them as known. */
+const GLOSSES = [
+  [/\bK\b/, "the stiffness matrix K = ∂²V/∂q²"],
+  [/\bC\b/, "the velocity matrix C = −∂Q/∂q̇ (damping, Coriolis)"],
+];
+
+/** `text` with the first unglossed K or C explained in place; `said` keeps what was. */
+function glossed(text, said) {
+  for (const [pattern, gloss] of GLOSSES) {
+    if (said.has(pattern) || !pattern.test(text)) continue;
+    said.add(pattern);
+    text = text.replace(pattern, gloss);
+  }
+  return text;
+}
+
+/** Modes that repeat an earlier shape (a degenerate pair at a pole) start the same motion. */
+function sameShape(a, b) {
+  return a.length === b.length && a.every((x, i) => Math.abs(x - b[i]) < 1e-9);
+}
+
 /** Each stability kind (the response's `kind`) in words. */
 const KIND_WORDS = {
   "stable": "Stable: the potential has a minimum here",
   "asymptotically stable": "Asymptotically stable: damping makes every small motion die out",
   "gyroscopically stable": "Gyroscopically stable: not a minimum of the potential, but the Coriolis terms keep small motions bounded (any damping would undo it)",
-  "marginal": "Marginal: the linear test cannot decide, the nonlinear terms do",
+  "marginal": "Marginal: neutral (no force pulls it back along some direction) or undecided by the linear test",
   "unstable": "Unstable: a small displacement grows",
 };
 
@@ -49,9 +80,14 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       return;
     }
     const ul = document.createElement("ul");
+    const said = new Set();
     for (const e of r.equilibria) {
       const li = document.createElement("li");
-      const where = Object.entries(e.q).map(([k, v]) => inline(`${nameTex(k)} = ${fmt(v)}`)).join(", ");
+      // in the scene's coordinate order; a free coordinate is 'any φ', as the steps say it
+      const names = (spec?.coordinates || []).filter((k) => k in e.q);
+      const order = names.length === Object.keys(e.q).length ? names : Object.keys(e.q);
+      const where = order.map((k) => (e.free.includes(k)
+        ? `any ${inline(nameTex(k))}` : inline(`${nameTex(k)} = ${fmt(e.q[k])}`))).join(", ");
       // the closed form as math (symbolic_latex); the plain `symbolic` only to tell whether it
       // says more than the numbers do (θ = 0 needs no second line)
       const latex = e.symbolic_latex || {};
@@ -65,11 +101,15 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
         <div class="muted closed"></div><div class="muted freq"></div><div class="muted why"></div><div class="buttons"></div>`;
       li.querySelector(".where").textContent = where;
       const tag = li.querySelector(".tag");
-      tag.classList.add(e.stable ? "stable" : "unstable");
+      const badge = KIND_CLASS[kind] || (e.stable ? "stable" : "unstable");
+      tag.classList.add(badge);
+      if (badge === "neutral") Object.assign(tag.style, NEUTRAL);
       tag.textContent = kind;
       tag.title = KIND_WORDS[kind] || "";
       // the reason says why in full; the kind's own gloss would say half of it twice
-      if (e.reason) li.querySelector(".why").textContent = `${kind[0].toUpperCase()}${kind.slice(1)}: ${e.reason}.`;
+      if (e.reason) {
+        li.querySelector(".why").textContent = glossed(`${kind[0].toUpperCase()}${kind.slice(1)}: ${e.reason}.`, said);
+      }
       if (spec) {
         const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
         svg.setAttribute("class", "eq-sketch");
@@ -84,7 +124,6 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       const condition = e.exists_when_latex || (known ? e.exists_when : "");
       const exists = condition ? ` (exists when ${e.exists_when_latex ? inline(condition) : condition})` : "";
       li.querySelector(".closed").textContent = closed + exists;
-      if (e.free.length) li.querySelector(".freq").textContent = `any ${e.free.map((k) => inline(nameTex(k))).join(", ")}`;
       if (e.frequencies.length) {
         li.querySelector(".freq").textContent = `${inline(`\\omega = ${e.frequencies.map((f) => fmt(f)).join(", ")}`)} rad/s`;
       }
@@ -98,7 +137,8 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       // A whirling mode (coordinates out of phase) is not a displacement pattern to start from.
       e.modes.forEach((mode, k) => {
         const phases = (e.mode_phases || [])[k] || [];
-        if (phases.every((p) => Math.abs(p) < 1e-9)) button(`excite mode ${k + 1}`, mode);
+        const repeat = e.modes.slice(0, k).some((other) => sameShape(other, mode));
+        if (!repeat && phases.every((p) => Math.abs(p) < 1e-9)) button(`excite mode ${k + 1}`, mode);
       });
       ul.append(li);
     }
