@@ -198,3 +198,36 @@ def test_a_bad_tolerance_is_said_once():
     r = client.get(f"{BASE}/trajectory.csv?tol=abc")
     assert r.status_code == 422
     assert r.json()["detail"] == [{"field": "tol", "message": "must be a finite number, not 'abc'"}]
+
+
+# --- with the share routes wired to run_problems (patch/share_run_check.patch) ----------------
+
+
+@pytest.mark.parametrize(
+    "state, field",
+    [
+        ({"scene_id": "simple_pendulum", "parameters": {"m": 0.0}}, "parameters.m"),
+        ({"scene_id": "particle_in_cone", "initial": {"r": 0.0}}, "initial.r"),
+        ({"scene_id": "atwood_machine", "initial": {"x": 100.0}}, "initial"),
+    ],
+)
+def test_a_share_of_a_state_the_run_refuses_is_refused_the_same_way(state, field):
+    expected = simulate_refusal({**state, "fps": 30.0, "rtol": 1e-9, "atol": 1e-9})
+    assert field in {p["field"] for p in expected}
+    r = client.post("/api/v1/export/share", json=state)
+    assert r.status_code == 422 and r.json()["detail"] == expected
+    token = token_of(state)
+    for url in (f"/api/v1/export/share/{token}", f"/s/{token}"):
+        r = client.get(url, follow_redirects=False)
+        assert r.status_code == 422
+        assert r.json()["detail"] == [{**p, "field": f"token.{p['field']}"} for p in expected]
+
+
+def test_a_posted_specs_share_is_checked_by_its_own_run():
+    from mechanics.scenes import load_scene
+
+    spec = load_scene("simple_pendulum")
+    r = client.post("/api/v1/export/share", json={"scene": spec, "parameters": {"m": 0.0}})
+    assert r.status_code == 422
+    assert r.json()["detail"][0]["field"] == "parameters.m"
+    assert client.post("/api/v1/export/share", json={"scene": spec}).status_code == 200

@@ -15,7 +15,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from typing import Annotated, Any, Literal
 from urllib.parse import urlencode
 
@@ -36,6 +36,8 @@ from mechanics.export_share import (
     ShareError,
     decode_state,
     encode_state,
+    page_run,
+    run_problems,
     state_problems,
 )
 from mechanics.integrators import METHODS
@@ -440,13 +442,15 @@ class ShareLink(BaseModel):
 @router.post(
     API + "/share",
     response_model=ShareLink,
-    responses={422: _ERRORS[422]},
+    responses={422: _ERRORS[422], 503: _ERRORS[503]},
     summary="A link that restores a page's state",
 )
 async def post_share(state: ShareState, http: Request) -> ShareLink:
     """The state compressed into a URL: the link carries the scene (a posted spec too), the
     parameters, initial state, method, tolerances or step, t_end and lecture step, with every
-    number exact. Nothing is stored on the server, so it works on any server, forever."""
+    number exact. Nothing is stored on the server, so it works on any server, forever. A state
+    the page it opens could not run (m = 0, a state past a stop) is refused with /simulate's own
+    field and reason."""
     _only_query(http, (), "this link is made from its JSON body only")
     document = state.model_dump(mode="json", by_alias=True, exclude_unset=True)
     problems = state_problems(document)
@@ -454,6 +458,7 @@ async def post_share(state: ShareState, http: Request) -> ShareLink:
         raise unknown_scene(document["scene_id"])  # the 404 of every other unknown scene_id
     if problems:
         raise HTTPException(422, problems)
+    await _runnable(state, document, http, prefix="")
     try:
         token = encode_state(document)
     except (ShareError, ValueError) as exc:
@@ -470,7 +475,7 @@ async def post_share(state: ShareState, http: Request) -> ShareLink:
 )
 async def get_share(token: str, http: Request) -> ShareState:
     """The state of `/s/{token}`, as JSON (what the page restores). A token this app did not
-    write answers 422 naming what is wrong with it."""
+    write, or whose run /simulate would refuse, answers 422 naming what is wrong with it."""
     _only_query(http, (), "a share token carries the whole state")
     return await _decoded(token, http)
 
@@ -510,7 +515,37 @@ async def _decoded(token: str, http: Request) -> ShareState:
         raise HTTPException(
             422, [{"field": f"token.{p['field']}", "message": p["message"]} for p in problems]
         )
+    await _runnable(state, document, http, prefix="token.")
     return state
+
+
+async def _runnable(
+    state: ShareState, document: Mapping[str, Any], http: Request, prefix: str
+) -> None:
+    """A 422 with /simulate's own fields and reasons when the run the page makes of this state
+    would be refused (mechanics.export_share.run_problems): a built-in scene's checks in this
+    process, a posted spec's in the pool, where its other work runs, under the same budget."""
+    request = page_run(document)
+    if state.scene_id is not None:
+        problems = await derivations.in_process(
+            http, run_problems, state.scene_id, None, request, what="checking the shared run"
+        )
+    else:
+        key = await run_in_threadpool(derivations.posted_key, state.scene)
+        problems = await run_in_threadpool(
+            derivations.in_pool,
+            http,
+            run_problems,
+            None,
+            key,
+            request,
+            affinity=key,
+            what="checking the shared run",
+        )
+    if problems:
+        raise HTTPException(
+            422, [{"field": prefix + p["field"], "message": p["message"]} for p in problems]
+        )
 
 
 #: pydantic names the model class a value should have been ("a valid dictionary or instance of
