@@ -60,6 +60,11 @@ def test_a_neutral_family_has_its_own_badge_colour_and_k_is_explained(server, pa
     assert items.first.locator(".where").inner_text().replace("\n", "").startswith("any")
     why = p.locator("#equilibria .why").all_inner_texts()
     assert "stiffness matrix K = ∂²V/∂q²" in why[0]
+    # axe (as tests/browser/test_a11y.py runs it) on the panel with the neutral badge
+    from axe_playwright_python.sync_playwright import Axe
+
+    found = Axe().run(p, context="#equilibria").response["violations"]
+    assert [v["id"] for v in found if v["impact"] in ("serious", "critical")] == []
     # and the unstable pink is another colour: the simple pendulum's top
     open_equilibria(page, server, "simple_pendulum")
     kinds = [badge_colours(p, i) for i in range(p.locator("#equilibria .tag").count())]
