@@ -9,6 +9,7 @@ its time budget ``scene``; a path that names no route has ``path``.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from typing import Any
 
@@ -214,6 +215,12 @@ def _one_message(messages: list[str]) -> str:
     return "; ".join(messages)
 
 
+#: pydantic names the model class a value should have been ("Input should be a valid dictionary
+#: or instance of SceneSpec"): a Python class name means nothing to whoever sent the request.
+_CLASS_NAME = re.compile(r" or instance of \w+")
+
+
 def _readable(message: str) -> str:
     # pydantic prefixes a validator's own words with "Value error, "; the field already says where.
-    return message.removeprefix("Value error, ")
+    message = _CLASS_NAME.sub("", message.removeprefix("Value error, "))
+    return message.replace("a valid dictionary or object to extract fields from", "a JSON object")

@@ -264,3 +264,13 @@ def test_every_environment_variable_read_anywhere_is_a_setting_and_documented():
     read.discard("LAGRANGE_LAB_")  # the prefix itself, in app/settings.py
     assert read <= names, read - names
     assert names == documented
+
+
+def test_a_refusal_names_no_python_class(client):
+    """pydantic's 'a valid dictionary or instance of SceneSpec' / 'object to extract fields
+    from' mean nothing to a course tool: the one error shape says 'a JSON object'."""
+    for body in ({"scene": 5}, {"scene": [1, 2]}, {"scene": "pendulum"}):
+        r = client.post("/api/v1/derive", json=body)
+        assert r.status_code == 422
+        [error] = r.json()["detail"]
+        assert error == {"field": "scene", "message": "Input should be a JSON object"}
