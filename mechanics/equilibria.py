@@ -660,8 +660,42 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
             f"The numeric search stopped at its time limit ({SEARCH_SECONDS:g} s): "
             "equilibria may be missing."
         )
-    notes += [_edge_note(m, edge) for edge in system.edges if not roots]
+    notes += [
+        _edge_note(m, edge)
+        for edge in system.edges
+        if not roots and _balanced_at_edge(v, conditions, edge, values, system.spread)
+    ]
     return roots, notes
+
+
+def _balanced_at_edge(
+    v: Variant, conditions: list[sp.Expr], edge: dict[int, float], values: dict, spread: float
+) -> bool:
+    """Do the forces really balance at a point where a declared-positive coordinate is 0?
+    There the coordinates are singular and Q_j = 0 can be their artefact: an elastic pendulum
+    without its spring (k = 0) has Q_r = m g cos θ, Q_θ = −m g r sin θ, both 0 at r = 0,
+    θ = π/2, where gravity pulls as ever. The size of the force, Qᵀ M⁻¹ Q (the kinetic metric,
+    which undoes the vanishing r² in M_θθ), must shrink as the point is approached from
+    inside: like r² for a spring of rest length 0 at its anchor, not at all for gravity."""
+    m = v.model
+    positive = [j for j in edge if m.coordinate_names[j] in m.spec.positive_coordinates]
+    sizes = []
+    for eps in (1e-3 * spread, 1e-5 * spread):
+        q = [edge.get(j, 0.0) for j in range(len(m.q))]
+        for j in positive:
+            q[j] = eps
+        at = {**values, **{qj: sp.Float(x) for qj, x in zip(m.q, q, strict=True)}}
+        at[m.names["t"]] = sp.S.Zero
+        try:
+            Q = np.array([float(sp.S.Zero + c.xreplace(at)) for c in conditions])
+            M = np.array(
+                [[float(sp.S.Zero + e.xreplace(at)) for e in row] for row in v.mass_matrix.tolist()]
+            )
+            sizes.append(float(Q @ np.linalg.solve(M, Q)))
+        except (TypeError, ValueError, np.linalg.LinAlgError):
+            return False
+    far, near = sizes
+    return math.isfinite(far) and near <= 1e-2 * far + 1e-300
 
 
 _EDGE = "The forces balance only at"

@@ -83,6 +83,16 @@ def test_the_elastic_pendulum_resting_at_its_anchor_is_not_called_no_equilibrium
     assert not any("every value of theta" in w for w in out["warnings"])
 
 
+def test_the_elastic_pendulum_without_its_spring_cannot_rest_anywhere():
+    """k = 0: only gravity acts on the bob, so nothing balances it, not even at r = 0, θ = π/2
+    where Q_r = m g cos θ and Q_θ = −m g r sin θ both vanish (an artefact of the polar
+    coordinates: gravity still pulls there)."""
+    out = equilibria(derivation_of_scene("elastic_pendulum"), {"k": 0.0})
+    assert out["equilibria"] == []
+    assert not any("can rest" in w for w in out["warnings"])
+    assert any("never balance" in w for w in out["warnings"])
+
+
 # --- 2. families of equilibria ----------------------------------------------------------------
 
 
