@@ -664,6 +664,11 @@ class _Judge:
 
     # -- what is wrong ---------------------------------------------------------------------
     def _diagnose(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:
+        small_angle = self._small_angle(given, expected)
+        if small_angle:
+            fb.append(small_angle)
+            fb += self._units(given)
+            return
         ratio = self._ratio(given, expected)
         if ratio == -1:
             fb.append("Sign error: your answer is the negative of the correct one.")
@@ -728,6 +733,115 @@ class _Judge:
             ]
         if self.quantity in ("V", "L"):  # a constant only moves the datum: neither missing
             g, e = {k: v for k, v in g.items() if k != 1}, {k: v for k, v in e.items() if k != 1}
+        fb = []
+        for velocity in dict.fromkeys([*map(self._velocity, e), *map(self._velocity, g)]):
+            mine = {k: v for k, v in g.items() if self._velocity(k) == velocity}
+            theirs = {k: v for k, v in e.items() if self._velocity(k) == velocity}
+            fb += self._group_terms(velocity, mine, theirs) or self._piece_terms(mine, theirs)
+        return fb
+
+    def _small_angle(self, given: sp.Expr, expected: sp.Expr) -> str:
+        """A sentence when the answer is the derived result with sin x ≈ x, cos x ≈ 1 (or
+        1 − x²/2), tan x ≈ x: an approximation, valid only near the angles' zero, not a slip.
+
+        Judged group by group of velocity monomials (T's cross term may be cos(θ₁ − θ₂) ≈ 1
+        while V keeps its cos θ₁ exact, or takes 1 − θ₁²/2), each match proved, not sampled."""
+        g, e = self._canonical(given), self._canonical(expected)
+        if len(g) + len(e) > MAX_TERMS:
+            return ""
+        if self.quantity in ("V", "L"):  # the datum: 1 − θ²/2 may come without its 1
+            g, e = {k: v for k, v in g.items() if k != 1}, {k: v for k, v in e.items() if k != 1}
+        used: dict[sp.Expr, sp.Expr] = {}
+        for velocity in dict.fromkeys([*map(self._velocity, e), *map(self._velocity, g)]):
+            mine = sp.Add(*(c * k for k, c in g.items() if self._velocity(k) == velocity))
+            theirs = tidy(
+                sp.Add(*(c * k for k, c in e.items() if self._velocity(k) == velocity)), self.m
+            )
+            if zero_proof(mine - theirs, self.m) is True:
+                continue
+            same = zero_proof
+            if self.quantity in ("V", "L") and velocity == 1:
+                same = constant_proof  # −m g l (1 − θ²/2) and m g l θ²/2 are one datum apart
+            for order in (1, 2):
+                approximate, replaced = self._approximate(theirs, order)
+                if replaced and same(mine - approximate, self.m) is True:
+                    used.update(replaced)
+                    break
+            else:
+                return ""
+        if not used:
+            return ""
+        angles = sorted({q for atom in used for q in self.m.q if atom.has(q)}, key=self.m.q.index)
+        where = " = ".join([*(inline(q)[1:-1] for q in angles), "0"])
+        atoms = sorted(used, key=sp.default_sort_key)
+        taken = ", ".join(f"${to_latex(a)} \\approx {to_latex(used[a])}$" for a in atoms)
+        kept = ", ".join(inline(a) for a in atoms)
+        return (
+            f"This is the small-angle approximation of the right answer ({taken}): valid only "
+            f"for small swings, near ${where}$, not in general. The exact answer keeps "
+            f"{kept}."
+        )
+
+    def _approximate(self, e: sp.Expr, order: int) -> tuple[sp.Expr, dict[sp.Expr, sp.Expr]]:
+        """``e`` with sin, cos, tan of the coordinates replaced by their Taylor polynomials at
+        0: sin x ≈ x, tan x ≈ x, and cos x ≈ 1 (order 1) or 1 − x²/2 (order 2)."""
+        replaced: dict[sp.Expr, sp.Expr] = {}
+        for f in e.atoms(sp.sin, sp.cos, sp.tan):
+            x = f.args[0]
+            if not any(x.has(q) for q in self.m.q):
+                continue  # cos(w t): no angle to be small
+            if isinstance(f, sp.cos):
+                replaced[f] = sp.S.One if order == 1 else 1 - x**2 / 2
+            else:
+                replaced[f] = x
+        return e.xreplace(replaced), replaced
+
+    def _velocity(self, mono: sp.Expr) -> sp.Expr:
+        """The q̇/q̈ part of a canonical monomial: θ̇₁ θ̇₂ of cos θ₁ cos θ₂ θ̇₁ θ̇₂."""
+        return mono.as_independent(*self.m.qd, *self.m.qdd, as_Add=False)[1]
+
+    def _group_terms(
+        self, velocity: sp.Expr, g: dict[sp.Expr, sp.Expr], e: dict[sp.Expr, sp.Expr]
+    ) -> list[str]:
+        """The terms with one velocity monomial, named whole when they read as one term.
+
+        The canonical form splits cos(θ₁ − θ₂) into cos θ₁ cos θ₂ + sin θ₁ sin θ₂; a student who
+        left out the cross term, or wrote cos(θ₁ + θ₂), should read about the term they wrote,
+        l₁ l₂ m₂ cos(θ₁ − θ₂) θ̇₁ θ̇₂, not about its two halves. [] when the group does not
+        tidy to a single term (the pieces are then compared one by one)."""
+        whole_e = tidy(sp.Add(*(c * k for k, c in e.items())), self.m)
+        whole_g = tidy(sp.Add(*(c * k for k, c in g.items())), self.m)
+        if not e:
+            if not g or whole_g.is_Add:
+                return []
+            return [f"Extra term {inline(whole_g)}: the correct answer has none like it."]
+        if whole_e.is_Add or (len(e) == 1 and len(g) <= 1):
+            return []  # one piece each (or a sum): the piece by piece lines say it as well
+        if not g:
+            return [f"Missing term {inline(whole_e)}{self._source(velocity)}."]
+        ratio = self._fixed_ratio(self.values(whole_g), self.values(whole_e))
+        if ratio == 1 and all(sp.simplify(g.get(k, 0) - c) == 0 for k, c in e.items()):
+            return []
+        if ratio == -1:
+            return [f"Sign error in the {inline(whole_e)} term."]
+        if ratio is not None and ratio != 1:
+            return [f"The term {inline(whole_e)} is off by a factor of {inline(ratio)}."]
+        if whole_g.is_Add or velocity == 1:
+            return []
+        line = f"Your {inline(velocity)} term is {inline(whole_g)}; it should be {inline(whole_e)}."
+        wrong = self._functions(whole_g) - self._functions(whole_e)
+        right = self._functions(whole_e) - self._functions(whole_g)
+        if len(wrong) == 1 and len(right) == 1:
+            (w,), (r,) = wrong, right
+            line += f" It has {inline(w)} where {inline(r)} belongs."
+        return [line]
+
+    @staticmethod
+    def _functions(e: sp.Expr) -> set[sp.Expr]:
+        return set(e.atoms(sp.sin, sp.cos, sp.tan))
+
+    def _piece_terms(self, g: dict[sp.Expr, sp.Expr], e: dict[sp.Expr, sp.Expr]) -> list[str]:
+        """The canonical pieces compared one by one: missing, extra, sign, factor, coefficient."""
         fb = []
         for mono, coeff in e.items():
             term = coeff * mono
