@@ -566,13 +566,16 @@ def _variants(d: Derivation, base: Variant, zeros: tuple) -> tuple[list[Variant]
     """Every side of every spring's anchor (bounded), with a note when not all were searched.
 
     A spring whose rest length is 0 here has no sides: ½k p² is smooth through its anchor, where
-    it rests when nothing else pulls (its range p > 0 had left that equilibrium out)."""
+    it rests when nothing else pulls (its range p > 0 had left that equilibrium out); nor has a
+    spring of stiffness 0, which pulls on nothing."""
     m = d.model
     to_zero = {p: sp.S.Zero for p in zeros}
-    springs = [
+    springs = [  # with k = 0 a spring exerts nothing: its side does not matter either
         s
         for s in m.springs
-        if getattr(s, "branch", None) is not None and s.rest_length.xreplace(to_zero) != 0
+        if getattr(s, "branch", None) is not None
+        and s.rest_length.xreplace(to_zero) != 0
+        and s.k.xreplace(to_zero) != 0
     ]
     variants, warnings = [], []
     for flips in itertools.product((False, True), repeat=len(springs)):
@@ -607,7 +610,7 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
     to_zero = {m.q[j]: 0 for j in free}
     eqs = [conditions[j].xreplace(to_zero) for j in bound]
     family = _linear_family(m, eqs, bound, values)
-    if family is not None:
+    if family is not None and _in_range(v, family.numeric, values):
         return [family], notes
     system = _System(v, eqs, bound, values, periods)
     symbolic = _symbolic(m, eqs, bound, values, periods)
@@ -714,6 +717,18 @@ def _edge_note(m: Any, edge: dict[int, float]) -> str:
         "loses its meaning at the origin). The system can rest there, but these coordinates "
         "cannot linearize about it, so it is not listed."
     )
+
+
+def _in_range(v: Variant, point: dict[int, float], values: dict) -> bool:
+    """Is the point inside the variant's ranges (a spring's side of its anchor, a positive
+    coordinate > 0)? A family's point outside them is left to the search, as before."""
+    m = v.model
+    ranges = [m.q[j] for j, n in enumerate(m.coordinate_names) if n in m.spec.positive_coordinates]
+    at = {**values, **{q: sp.Float(point.get(j, 0.0)) for j, q in enumerate(m.q)}}
+    try:
+        return all(float(r.xreplace(at)) > 1e-9 for r in [*ranges, *v.ranges])
+    except (TypeError, ValueError):
+        return False
 
 
 def _linear_family(m: Any, eqs: list[sp.Expr], bound: list[int], values: dict) -> Root | None:
