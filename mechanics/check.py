@@ -39,6 +39,11 @@ PROOF_OPS = 400
 #: Past PROOF_OPS, up to this size, only the evaluation at exact random points is tried (a
 #: solved q̈ of the double pendulum, typed out expanded, is 533 operations).
 MAX_PROOF_OPS = 4000
+#: A normal form (expanded) is tried only up to this many terms of expansion ((sin θ + cos θ)⁶⁰
+#: is 61 terms, and 15 s of trig passes); past it, exact evaluation decides alone.
+MAX_NORMAL_TERMS = 40
+#: No proof past this exponent: exact rationals to the 10⁴th power are megabytes of digits.
+MAX_PROOF_POWER = 256
 #: sympy's general simplify() is the last resort, and only this small (it is the slow one).
 SIMPLIFY_OPS = 60
 #: |·| and sign() are settled by trying both signs of their argument: 2**k cases for k of them.
@@ -105,9 +110,11 @@ def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
     w t ...) only sympy's simplify() can show a zero, and nothing is claimed non-zero.
     """
     ops = sp.count_ops(expr)
-    if ops > MAX_PROOF_OPS or _expansion_size(expr, 8 * MAX_TERMS) > 8 * MAX_TERMS:
+    if ops > MAX_PROOF_OPS or _max_power(expr) > MAX_PROOF_POWER:
         return None
-    if ops <= PROOF_OPS and tidy(expr, model) == 0:
+    # expanding is what normal forms cost: past a small expansion, only exact evaluation
+    small = ops <= PROOF_OPS and _expansion_size(expr, MAX_NORMAL_TERMS) <= MAX_NORMAL_TERMS
+    if small and tidy(expr, model) == 0:
         return True
     to_sym, _ = _symbols_for(model)
     e = expr.xreplace(to_sym)
@@ -116,12 +123,12 @@ def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
     cases = _sign_cases(e)
     if cases is None:
         return None
-    results = [_zero_by_algebra(c) for c in cases]
+    results = [_zero_by_algebra(c, small) for c in cases]
     if all(r is True for r in results):
         return True
     if len(cases) == 1 and results[0] is False:
         return False  # with a case split, a non-zero branch may be one no state reaches
-    if len(cases) == 1 and sp.count_ops(e) <= SIMPLIFY_OPS and sp.simplify(e) == 0:
+    if small and len(cases) == 1 and sp.count_ops(e) <= SIMPLIFY_OPS and sp.simplify(e) == 0:
         return True
     return None
 
@@ -162,8 +169,14 @@ def _sign_cases(e: sp.Expr) -> list[sp.Expr] | None:
     return cases
 
 
-def _zero_by_algebra(e: sp.Expr) -> bool | None:
-    """zero_proof's exact argument for a rational function of sin, cos and the symbols."""
+def _max_power(e: sp.Expr) -> int:
+    """The largest integer exponent in ``e`` (a tower (θ⁶⁴)⁶⁴ counts as written, 64)."""
+    return max((abs(int(p.exp)) for p in e.atoms(sp.Pow) if p.exp.is_Integer), default=0)
+
+
+def _zero_by_algebra(e: sp.Expr, normal_form: bool = True) -> bool | None:
+    """zero_proof's exact argument for a rational function of sin, cos and the symbols: its
+    normal form when ``normal_form`` (small), else exact evaluation at random points."""
     e = e.replace(sp.tan, lambda a: sp.sin(a) / sp.cos(a))
     e = e.replace(sp.cot, lambda a: sp.cos(a) / sp.sin(a))
     e = e.replace(sp.sec, lambda a: 1 / sp.cos(a))
@@ -188,7 +201,7 @@ def _zero_by_algebra(e: sp.Expr) -> bool | None:
     )
     if not e.is_rational_function(*e.free_symbols):
         return None  # exp, log, a square root of a variable, ...
-    if sp.count_ops(e) > PROOF_OPS:
+    if not normal_form or sp.count_ops(e) > PROOF_OPS:
         return _zero_at_random_points(e, pairs)
     numerator, denominator = sp.fraction(sp.together(e))
     if _reduce_circle(denominator, pairs) == 0:
@@ -420,26 +433,32 @@ class _Judge:
         """A difference the samples could not see but a proof did, named whole when the term by
         term comparison would not put it as extra terms: a θ̈ written over another denominator
         compares term by term as 'missing' what is only written differently."""
-        ratios = [
-            x / y
-            for x, y in zip(self.values(diff), self.values(self.expected), strict=True)
-            if abs(y) > 0 and cmath.isfinite(x / y)
-        ]
-        if ratios and all(abs(r - ratios[0]) <= 1e-6 * abs(ratios[0]) for r in ratios):
+        if self._proportional(diff, self.expected):
             return False  # a factor a hair from 1 (1 + 1e-12): _diagnose says so
         terms = self._terms(self.given, self.expected)
         if terms and all(line.startswith("Extra term") for line in terms):
             return False  # _diagnose names them, with their units
-        small = sp.count_ops(diff) <= PROOF_OPS and _expansion_size(diff, MAX_TERMS) <= MAX_TERMS
+        small = (
+            sp.count_ops(diff) <= PROOF_OPS
+            and _expansion_size(diff, MAX_NORMAL_TERMS) <= MAX_NORMAL_TERMS
+        )
         shown = tidy(diff, self.m) if small else None
-        if shown is None or sp.count_ops(shown) > 30:
-            return False
+        named = f" by {inline(shown)}" if shown is not None and sp.count_ops(shown) <= 30 else ""
         fb.append(
-            f"Your answer differs from the derived result by {inline(shown)}: too small to show "
-            "at the states sampled, but not zero."
+            f"Your answer differs from the derived result{named}: a difference too small to "
+            "show at the states sampled, but sympy shows it is not zero."
         )
         fb += self._units(self.given)
         return True
+
+    def _proportional(self, a: sp.Expr, b: sp.Expr) -> bool:
+        """Is a/b one number at every sample, however small (10⁻¹² of b is a factor 1 + 10⁻¹²)?"""
+        ratios = [
+            x / y
+            for x, y in zip(self.values(a), self.values(b), strict=True)
+            if abs(y) > 0 and cmath.isfinite(x / y)
+        ]
+        return bool(ratios) and all(abs(r - ratios[0]) <= 1e-6 * abs(ratios[0]) for r in ratios)
 
     def _unconfirmed(self, diff: sp.Expr, constant: bool = False, claim: str = "") -> str:
         """Why an answer the samples cannot fault is still not marked correct."""

@@ -190,3 +190,33 @@ def test_api_does_not_call_a_bump_correct():
     assert r.status_code == 200, r.text
     assert r.json()["correct"] is False
     assert "Not confirmed" in r.json()["feedback"][0]
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize(
+    "answer",
+    [
+        f"{T_PENDULUM} + 1e-300*(sin(theta) + cos(theta))**60",  # 61 terms: 15 s of trig passes
+        f"{T_PENDULUM} + 1e-300*(theta + theta_dot + m + 1)**30",
+        f"{T_PENDULUM} + 1e-300*sin(theta + theta_dot + m + l + g + t)**8",
+    ],
+)
+def test_a_tiny_power_is_decided_without_expanding_it(answer):
+    """Provably non-zero (a non-zero polynomial in θ, sin θ, cos θ, θ̇ and the parameters), and
+    decided by exact evaluation, not by expansion: quickly, and named as a difference, not as
+    'a factor that differs from 1 past the ninth digit'."""
+    started = time.perf_counter()
+    v = verdict(answer)
+    assert time.perf_counter() - started < 3
+    assert v.correct is False
+    assert "not zero" in v.feedback[0] and "factor" not in v.feedback[0], v.feedback
+
+
+def test_a_multiple_angle_identity_in_two_coordinates_is_proved():
+    """sin²(3θ₁ − 5θ₂) + cos²(3θ₁ − 5θ₂) = 1, cubed, on the double pendulum's cross term."""
+    answer = (
+        "(m1 + m2)/2*l1**2*theta1_dot**2 + m2/2*l2**2*theta2_dot**2"
+        " + m2*l1*l2*cos(theta1 - theta2)*theta1_dot*theta2_dot"
+        " * (sin(3*theta1 - 5*theta2)**2 + cos(3*theta1 - 5*theta2)**2)**3"
+    )
+    assert verdict(answer, scene="double_pendulum").correct is True
