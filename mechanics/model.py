@@ -11,10 +11,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import sympy as sp
+from sympy.core.function import AppliedUndef
 from sympy.physics.mechanics import Particle, RigidBody, inertia
 from sympy.physics.vector import Point, ReferenceFrame, Vector, dynamicsymbols
 
-from mechanics.expr import parse
+from mechanics.expr import parse, to_plain
 from mechanics.spec import FramePosition, SceneSpec, nonnegative_parameters, parse_spec
 
 T = dynamicsymbols._t
@@ -85,6 +86,9 @@ class StopInfo:
     crossing: str = "falls"
     only_if: sp.Expr | None = None
     along: tuple[float, float, float] | None = None  # unit vector in N: the string's direction
+    #: "declared", or an implicit one: "anchor", "positive", "domain" (a position's domain end,
+    #: approached tangentially when the mass matrix blows up there: x = l√θ at θ = 0).
+    kind: str = "declared"
 
 
 @dataclass
@@ -186,7 +190,15 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         so abs() or sign() of a coordinate in it is refused with its field (its derivative
         stays unevaluated and every later step would fail); a force may hold sign(s_dot)."""
         table = names if allow_velocity else {k: v for k, v in names.items() if "_dot" not in k}
-        return parse(value, table, field=where, smooth=smooth)
+        out = parse(value, table, field=where, smooth=smooth)
+        if smooth:
+            _refuse_root_of_square(out, where)
+            differentiated.append((where, out))
+        return out
+
+    #: Every expression differentiated in time, with its field: their domains end where a root
+    #: or a logarithm of a coordinate-dependent argument does (implicit stops, below).
+    differentiated: list[tuple[str, sp.Expr]] = []
 
     frames: dict[str, FrameInfo] = {}
     for i, f in enumerate(spec.frames):
@@ -341,7 +353,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         StopInfo(
             st.name,
             st.message,
-            None if st.when is None else expr(st.when, f"stops[{i}].when", allow_velocity=True),
+            None if st.when is None else _stop_value(expr, st, i, names),
             st.tension,
             st.crossing,
             None
@@ -359,16 +371,19 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
                     f"the spring {s.name} reaches zero length: its direction is undefined "
                     "there (V = ½k(|d| − ℓ₀)² has a corner), so the model ends",
                     _corner_only_if_stretched(s.branch, s.rest_length),
+                    kind="anchor",
                 )
             )
+    stops += _domain_stops(differentiated, spec, names)
     for name, qi in zip(spec.coordinates, q, strict=True):
         if name in spec.positive_coordinates:
             stops.append(
                 StopInfo(
                     f"{name}_at_zero",
-                    f"{name} reaches 0, where the coordinates are singular "
-                    f"({name} is declared positive)",
+                    f"{name} reaches 0: it is declared positive, and the equations were "
+                    f"derived for {name} > 0 only",
                     qi,
+                    kind="positive",
                 )
             )
     return Model(
@@ -406,6 +421,161 @@ def _corner_only_if_stretched(branch: sp.Expr, rest_length: sp.Expr) -> sp.Expr:
     if rest_length.is_zero is False:
         return branch
     return sp.Piecewise((branch, sp.Ne(rest_length, 0)), (sp.S.One, True))
+
+
+def _real_twins(expr: sp.Expr, names: dict[str, sp.Expr]) -> sp.Expr:
+    """expr with q(t), q̇(t) and t as plain real symbols (velocities first: q̇ holds q), so
+    sympy's assumptions can decide its sign for every real state. Coordinates declared positive
+    become merely real: a stop is there to catch them leaving their domain."""
+    out = expr
+    for name, value in sorted(names.items(), key=lambda kv: -kv[0].count("_dot")):
+        if not isinstance(value, sp.Symbol):  # parameters keep their assumptions (≥ 0 only
+            out = out.xreplace({value: sp.Dummy(name, real=True)})  # where requests enforce it)
+    return out.xreplace({T: sp.Dummy("t", real=True)})  # last: q(t) holds t
+
+
+def _stop_value(expr: Any, st: Any, i: int, names: dict[str, sp.Expr]) -> sp.Expr:
+    """A declared stop's `when`, refused (naming the field) when it cannot change sign.
+
+    A run stops where `when` crosses 0, seen as a change of sign between steps. A function that
+    is never negative (θ², 1 + θ²) can only touch 0 and a run cannot see it do so (a sampled
+    minimum is never exactly 0): it used to be silently ignored. We refuse it instead of guessing
+    at touches, which would also fire near every close approach; a stop that changes sign where
+    the model ends (θ, not θ²) is what to write.
+    """
+    where = f"stops[{i}].when"
+    value = expr(st.when, where, allow_velocity=True)
+    real = _real_twins(value, names)
+    from mechanics.spec import SpecError
+
+    def refuse(message: str) -> SpecError:
+        return SpecError([{"field": where, "message": message}])
+
+    if value == 0:  # 0 for good: no crossing to find, and no state past it (never reported)
+        return value
+    if real.is_positive or real.is_negative:
+        sign = "positive" if real.is_positive else "negative"
+        raise refuse(
+            f"{to_plain(value)} is {sign} in every state, so it never reaches 0 and the stop "
+            "could never fire: give an expression that is positive while the model holds and "
+            "changes sign where it ends"
+        )
+    if real.is_nonnegative or real.is_nonpositive:
+        raise refuse(
+            f"{to_plain(value)} never changes sign (it only touches 0), and a run finds a stop "
+            "where its expression changes sign: give one that does where the model ends "
+            "(e.g. theta rather than theta**2)"
+        )
+    return value
+
+
+_ROOTS = "a fractional power (a square root) of a negative number"
+
+
+def _domain_ends(value: sp.Expr) -> list[tuple[sp.Expr, str]]:
+    """What must stay > 0 for ``value`` to be a real number: the argument of each root, each
+    logarithm, and 1 − x² of each asin/acos, where it depends on a coordinate or t (with why)."""
+    out = []
+    for node in sp.preorder_traversal(value):
+        if isinstance(node, sp.Pow) and _fractional(node.exp):
+            end, why = node.base, _ROOTS
+        elif isinstance(node, sp.log):
+            end, why = node.args[0], "the logarithm of a number ≤ 0"
+        elif isinstance(node, sp.asin | sp.acos):
+            end, why = 1 - node.args[0] ** 2, f"{node.func.__name__} of a number outside [−1, 1]"
+        else:
+            continue
+        if end.has(AppliedUndef, T) and all(end != e for e, _ in out):
+            out.append((end, why))
+    return out
+
+
+def _fractional(exponent: sp.Expr) -> bool:
+    return exponent.is_number and exponent.is_integer is False
+
+
+def _domain_stops(
+    differentiated: list[tuple[str, sp.Expr]], spec: SceneSpec, names: dict[str, sp.Expr]
+) -> list[StopInfo]:
+    """An implicit stop where a position (or a frame's angle) reaches the end of its domain.
+
+    x = l√θ has no value past θ = 0: the equations may run on there, finite (they were derived
+    for θ > 0), and the run used to be flagged only by its energy drift. The stop ends it at
+    θ = 0 instead, located like any stop. An argument positive in every real state (1 + θ²)
+    has no end and gets no stop.
+    """
+    stops: list[StopInfo] = []
+    seen: list[sp.Expr] = []
+    for where, value in differentiated:
+        for end, why in _domain_ends(value):
+            if any(end == e for e in seen) or _real_twins(end, names).is_positive:
+                continue
+            seen.append(end)
+            what = _what_is_at(where, spec)
+            stops.append(
+                StopInfo(
+                    f"{what[1]}_domain_end" + (f"{len(seen)}" if len(seen) > 1 else ""),
+                    f"{what[0]} is undefined past {to_plain(end)} = 0 ({why} in {where}): "
+                    "the state would have left the domain of its position function, so the "
+                    "model ends there",
+                    end,
+                    kind="domain",
+                )
+            )
+    return stops
+
+
+def _what_is_at(where: str, spec: SceneSpec) -> tuple[str, str]:
+    """'bodies[1].position[0]' -> ('the position of bob', 'bob')."""
+    group, _, rest = where.partition("[")
+    index = int(rest.split("]", 1)[0])
+    item = getattr(spec, group)[index]
+    if group == "frames":
+        return f"the angle of frame {item.name}", item.name
+    return f"the position of {item.name}", item.name
+
+
+def _refuse_root_of_square(value: sp.Expr, where: str) -> None:
+    """√(f²) is |f|: refused in an expression differentiated in time, as abs() is (by the parser).
+
+    |sin θ| written as sqrt(sin(theta)**2) has a kink where sin θ = 0, and its derivative
+    f f'/√(f²) is 0/0 there. The same holds for any fractional power of an expression with an
+    even power of a coordinate-dependent factor (√(θ²l²), (θ²)^0.5, √(θ² − 2θ + 1) = |θ − 1|);
+    √(l²) of a constant and √(1 + θ²) are smooth and pass.
+    """
+    from mechanics.expr import ExprError
+
+    for node in sp.preorder_traversal(value):
+        if not (isinstance(node, sp.Pow) and _fractional(node.exp)):
+            continue
+        square = _square_factor(node.base)
+        if square is not None:
+            f = to_plain(square)
+            raise ExprError(
+                f"sqrt() of a square, here of {f}, is abs({f}): it has no derivative where "
+                f"{f} = 0, and this expression is differentiated in time (a position or an "
+                "angle): write it for the side the motion stays on",
+                field=where,
+            )
+
+
+def _square_factor(base: sp.Expr) -> sp.Expr | None:
+    """A coordinate-dependent f with f^(2k) a factor of ``base`` (after factoring), else None."""
+    if not base.has(AppliedUndef):
+        return None
+    forms = [base, sp.factor(base)]
+    if base.has(sp.sin, sp.cos) and sp.count_ops(base) <= 40:  # 1 − cos²θ = sin²θ
+        forms.append(sp.factor(sp.trigsimp(base)))
+    for form in forms:
+        for factor in sp.Mul.make_args(form):
+            if (
+                isinstance(factor, sp.Pow)
+                and factor.exp.is_integer
+                and factor.exp.is_even
+                and factor.base.has(AppliedUndef)
+            ):
+                return factor.base
+    return None
 
 
 def _unit(v: list[float] | None) -> tuple[float, float, float] | None:

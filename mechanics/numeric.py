@@ -44,6 +44,7 @@ class StopFunction:
     crossing: str  # "falls" | "any"
     value: Any
     only_if: Any | None = None
+    kind: str = "declared"  # see mechanics.model.StopInfo.kind
 
 
 @dataclass
@@ -114,7 +115,7 @@ class CompiledScene:
             guard = None
             if st.only_if is not None:
                 guard = sp.lambdify(args, [_plain(st.only_if, subs)], modules=_NUMPY)
-            out.append(StopFunction(st.name, st.message, st.crossing, value, guard))
+            out.append(StopFunction(st.name, st.message, st.crossing, value, guard, st.kind))
         return out
 
     def rhs(self, params: list[float]):
@@ -127,18 +128,25 @@ class CompiledScene:
 
             def rhs(time: float, y: np.ndarray) -> np.ndarray:
                 state = y.tolist()  # Python floats: math functions on numpy scalars are slow
-                return np.array(state[n : 2 * n] + f(time, *state[: 2 * n], *p))
+                try:
+                    return np.array(state[n : 2 * n] + f(time, *state[: 2 * n], *p))
+                except ValueError:  # math.sqrt(−1): past a domain's end, as numpy and C say
+                    return np.full(len(state), np.nan)
 
             return rhs
         mf, power = self.mass_and_forcing, self.accel_and_power
 
         def rhs(time: float, y: np.ndarray) -> np.ndarray:
             args = (time, *y.tolist()[: 2 * n], *p)
-            values = np.asarray(mf(*args), dtype=float)
+            try:
+                values = np.asarray(mf(*args), dtype=float)
+                rates = power(*args)
+            except ValueError:  # math.sqrt(−1): past a domain's end, as numpy and C say
+                return np.full(len(y), np.nan)
             out = np.empty(2 * n + self.extras)
             out[:n] = y[n : 2 * n]
             out[n : 2 * n] = np.linalg.solve(values[: n * n].reshape(n, n), values[n * n :])
-            out[2 * n :] = power(*args)
+            out[2 * n :] = rates
             return out
 
         return rhs

@@ -4,7 +4,7 @@ A run is watched for them after every step it takes in Python (`StopWatch`) and 
 samples after a compiled run (`first_stop`); the moment is then located by re-integrating the
 step with scipy's event detection, or by the secant where a discontinuity makes the steps chatter
 instead of crossing (friction sticking). A state already past a stop is refused before a run
-(`refuse_passed_stops`), and one exactly at a sign-change stop ends it at t = 0
+(`refuse_passed_stops`), and one exactly at a stop whose model ends there ends it at t = 0
 (`stopped_at_start`). See docs/model.md, "Stops".
 """
 
@@ -38,6 +38,7 @@ class StopEvent:
     message: str
     t: float
     run: Trajectory  # the run cut at the stop, its last sample the located state
+    kind: str = "declared"
 
 
 class StopWatch:
@@ -85,6 +86,12 @@ class StopWatch:
                 if before > 0 >= now and self.guard(stop, t, y):
                     self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
                     return True
+                # a domain's end is approached tangentially (θ ~ (t₀ − t)² for x = l√θ, whose M
+                # is infinite there): the steps creep into it and may bounce back off it
+                near = 0 < now <= self.NEAR_ZERO * self.scale[i]
+                if stop.kind == "domain" and near and self.guard(stop, t, y):
+                    self.hit = (i, t1, y1, t, np.array(y, dtype=float), "secant")
+                    return True
                 continue
             if np.sign(before) != np.sign(now) and before != 0 and self.guard(stop, t, y):
                 self.hit = (i, t1, y1, t, np.array(y, dtype=float), "crossed")
@@ -116,8 +123,13 @@ class StopWatch:
             return self.c.stops[i], *_first_undefined(self.c, self.c.stops[i], params, t0, y0, t1)
         if not math.isfinite(v0 - v1):
             return self.c.stops[i], t1, np.array(y1, dtype=float)
+        reach = 1.0  # steps past the last one the secant may reach
+        if self.c.stops[i].kind == "domain" and v0 > 0 and v1 > 0:
+            # a tangential approach, v ~ (t_end − t)²: √v is linear in t, and the steps shrink
+            # as they creep in (RK45 was still 12 steps short), so it may reach further
+            v0, v1, reach = math.sqrt(v0), math.sqrt(v1), 1000.0
         t_stop = t1 if v0 == v1 else t1 + v1 * (t1 - t0) / (v0 - v1)
-        t_stop = min(max(t_stop, t0), t1 + (t1 - t0))
+        t_stop = min(max(t_stop, t0), t1 + reach * (t1 - t0))
         crossed = np.sign(v0) != np.sign(v1)
         start, state = (t0, y0) if crossed or t_stop < t1 else (t1, y1)
         return self.c.stops[i], t_stop, _advance(self.c, params, start, state, t_stop)
@@ -174,12 +186,31 @@ def _stop_values_of(c, stop, t, y, params) -> tuple[np.ndarray, np.ndarray | Non
 
 def refuse_passed_stops(c: CompiledScene, params: list[float], y0: np.ndarray) -> None:
     """A run may not start where its model already does not hold (a slack string, a block
-    beyond the pulley): that is a 422 naming the initial state, not a motion to show."""
+    beyond the pulley): that is a 422 naming the initial state, not a motion to show.
+
+    Nor where a stop cannot be evaluated (`when` = sqrt(theta − 5) at θ = 0.5): a NaN never
+    crosses 0, so such a stop was silently never checked; it is a 422 naming its field.
+    """
     errors = []
-    for stop in c.stops:
+    declared = len(c.derivation.model.spec.stops)
+    for i, stop in enumerate(c.stops):
+        value, _ = _stop_values(c, stop, np.array([0.0]), y0[None, :], params)
+        if math.isnan(value[0]):
+            spec = c.derivation.model.spec.stops[i] if i < declared else None
+            errors.append(
+                {
+                    "field": "initial"
+                    if spec is None
+                    else f"stops[{i}].{'when' if spec.when is not None else 'tension'}",
+                    "message": f"the stop {stop.name} is undefined (not a number) in the "
+                    "initial state (a square root of a negative number, 0/0, ...), so the run "
+                    "could never tell whether it is reached: give an expression defined where "
+                    "the run starts",
+                }
+            )
+            continue
         if stop.crossing != "falls":
             continue
-        value, _ = _stop_values(c, stop, np.array([0.0]), y0[None, :], params)
         if value[0] < 0:
             errors.append(
                 {
@@ -192,16 +223,47 @@ def refuse_passed_stops(c: CompiledScene, params: list[float], y0: np.ndarray) -
         raise SpecError(errors)
 
 
-def stopped_at_start(c: CompiledScene, params: list[float], y0: np.ndarray) -> Any | None:
-    """A sign-change stop whose value is exactly 0 at the start, its guard holding (a block at
-    rest where static friction holds it): the model's motion ends before it begins."""
+def stopped_at_start(
+    c: CompiledScene, params: list[float], y0: np.ndarray, t_end: float = 1.0
+) -> Any | None:
+    """The stop that ends the run at t = 0, if any: one whose value is exactly 0 at the start and
+    whose model ends there.
+
+    A falling stop at 0 ends it when the motion heads into its forbidden side (a pendulum at
+    θ = 0 swinging to θ < 0 with `when` = θ: it used to run a full swing on that side); one
+    that heads into the allowed side, or stays at 0, starts normally. A sign-change stop
+    (`crossing` = "any") at 0 ends it only when its `only_if` is given and holds, the stop's
+    own statement that the model ends there (static friction holds a block at rest); without a
+    guard the state merely starts on the surface (θ = 0 moving, a velocity 0 at release) and
+    the run stops where the value next changes sign.
+    """
     for stop in c.stops:
-        if stop.crossing != "any":
-            continue
         value, guard = _stop_values(c, stop, np.array([0.0]), y0[None, :], params)
-        if value[0] == 0 and (guard is None or not guard[0] < 0):
+        if value[0] != 0 or (guard is not None and guard[0] < 0):
+            continue
+        if stop.crossing == "any" and stop.only_if is not None:
+            return stop
+        if stop.crossing == "falls" and _heading(c, stop, params, y0, t_end) < 0:
             return stop
     return None
+
+
+def _heading(c: CompiledScene, stop: Any, params: list[float], y0: np.ndarray, t_end: float):
+    """The sign a stop's value takes just after t = 0 (where it is 0): +1, −1, or 0 when it stays
+    at 0 as far as a short look ahead can tell (an equilibrium on the surface)."""
+    n = c.n
+    horizon = min(t_end, 1.0)
+    for h in (1e-6 * horizon, 1e-4 * horizon, 1e-2 * horizon):
+        if not h > 0:
+            break
+        y = _advance(c, params, 0.0, y0, h)
+        with np.errstate(all="ignore"):
+            v = float(np.asarray(stop.value(h, *y[:n], *y[n : 2 * n], *params)[0]))
+        if not math.isfinite(v):
+            return -1  # undefined just past the start: it left the model at once
+        if abs(v) > 1e-12:
+            return 1 if v > 0 else -1
+    return 0
 
 
 def first_stop(
@@ -259,7 +321,7 @@ def _cut(run: Any, k: int, stop: Any, t_stop: float, y_stop: np.ndarray) -> Stop
         run.wall_time,
         run.note,
     )
-    return StopEvent(stop.name, stop.message, float(t_stop), cut)
+    return StopEvent(stop.name, stop.message, float(t_stop), cut, stop.kind)
 
 
 def _crossing(value: np.ndarray, crossing: str, guard: np.ndarray | None) -> int | None:
