@@ -478,9 +478,9 @@ class _Judge:
         return (
             f"Not confirmed: your answer {what} at every state sampled, but sympy could not "
             f"show that {named} is {'a constant' if constant else 'zero'}. Samples can miss "
-            "a term that is there (a narrow bump like $e^{-10^{6} \\dot{\\theta}^{2}}$ is 0 at "
-            "all of them), so check it by hand, or write your answer more simply (expanded, "
-            "with sin and cos, without abs, exp or sqrt it does not need)."
+            "a term that is really there (a narrow bump, a tiny coefficient), so check it by "
+            "hand, or write your answer more simply (expanded, with sin and cos, without abs, "
+            "exp or sqrt it does not need)."
         )
 
     def _same_to_precision(self, given: sp.Expr, expected: sp.Expr) -> bool:
@@ -847,13 +847,17 @@ class _Judge:
             return [f"The term {inline(whole_e)} is off by a factor of {inline(ratio)}."]
         if whole_g.is_Add or velocity == 1:
             return []
-        line = f"Your {inline(velocity)} term is {inline(whole_g)}; it should be {inline(whole_e)}."
         wrong = self._functions(whole_g) - self._functions(whole_e)
         right = self._functions(whole_e) - self._functions(whole_g)
-        if len(wrong) == 1 and len(right) == 1:
+        if len(wrong) == 1 and len(right) == 1:  # cos(θ₁ + θ₂) for cos(θ₁ − θ₂): say just that
             (w,), (r,) = wrong, right
-            line += f" It has {inline(w)} where {inline(r)} belongs."
-        return [line]
+            return [
+                f"Your {inline(velocity)} term has {inline(w)} where {inline(r)} belongs: it "
+                f"should be {inline(whole_e)}."
+            ]
+        return [
+            f"Your {inline(velocity)} term is {inline(whole_g)}; it should be {inline(whole_e)}."
+        ]
 
     @staticmethod
     def _functions(e: sp.Expr) -> set[sp.Expr]:
