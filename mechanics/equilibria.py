@@ -1211,8 +1211,8 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     lost_names = ", ".join(m.coordinate_names[j] for j in lost)
     where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
     pole = (
-        f"{where} is a pole of the coordinates ({lost_names} is undefined there: its row of M "
-        f"vanishes), so only {', '.join(m.coordinate_names[j] for j in idx)} was linearized"
+        f"{where} is a pole of the coordinates (any {lost_names} names the same point: its row "
+        f"of M vanishes), so only {', '.join(m.coordinate_names[j] for j in idx)} was linearized"
     )
     radial = _radial(m, full_M, at_rest, q0, numbers, idx, lost)
     cyclic = all(j in free for j in lost)
