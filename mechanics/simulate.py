@@ -21,6 +21,7 @@ from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
+    EXTREME_EXPONENT,
     CompiledScene,
     compiled_scene,
     compiled_spec,
@@ -220,13 +221,32 @@ def _overflow(
     return "" if np.all(np.isfinite(accel)) else "the accelerations q̈"
 
 
+def _overflowed(
+    c: CompiledScene, params: list[float], req: Any, run: Trajectory
+) -> dict[str, str] | None:
+    """Why a run that turned non-finite did, when a parameter or initial value is extreme
+    (g = 1e308: q̈ = −g sin θ is finite at the start, and the first step overflows): the 422
+    entry naming them, as at the start. None when every value is of ordinary size: then inf is
+    the motion's own (a blow-up in finite time), and the run's message says when."""
+    text = run.message.lower()
+    if "non-finite" not in text and "overflow" not in text:
+        return None
+    values = {f"parameters.{k}": v for k, v in zip(c.parameters, params, strict=True)}
+    values |= {f"initial.{k}": v for k, v in req.initial.items()}
+    if not any(v != 0 and abs(math.log10(abs(v))) > EXTREME_EXPONENT for v in values.values()):
+        return None
+    when = "in its first step" if len(run.t) <= 1 else f"by t = {float(run.t[-1]):.4g} s"
+    return overflow_error(values, [], f"the motion overflows double precision {when}")
+
+
 def _too_large(c: CompiledScene, params: list[float], req: Any, what: str) -> dict[str, str]:
     """Name the parameters or initial values that overflowed (the overridden ones, when none
     is extreme)."""
     values = {f"parameters.{k}": v for k, v in zip(c.parameters, params, strict=True)}
     values |= {f"initial.{k}": v for k, v in req.initial.items()}
     named = [f"parameters.{k}" for k in req.parameters] + [f"initial.{k}" for k in req.initial]
-    return overflow_error(values, named, f"{what} overflows double precision at the start")
+    verb = "overflow" if what == "the accelerations q̈" else "overflows"
+    return overflow_error(values, named, f"{what} {verb} double precision at the start")
 
 
 def _singular_mass(c: CompiledScene, params: list[float], names: str) -> dict[str, str]:
@@ -334,7 +354,12 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         run = stop.run
         warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
     elif run.status != "ok":
+        overflow = _overflowed(c, params, req, run)
+        if overflow is not None and len(run.t) <= 1:  # not one step: as a start that overflows
+            raise SpecError([overflow])
         warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
+        if overflow is not None:
+            warnings.append(overflow["message"][0].upper() + overflow["message"][1:] + ".")
         if "wall-time" in run.message:  # out of time: stiffness, or a busy server
             stiff = not METHODS[req.method].implicit and _looks_stiff(c, params, run)
             warnings.append(

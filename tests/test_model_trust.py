@@ -114,3 +114,52 @@ def test_the_same_spec_with_the_rest_length_overridden_to_zero_passes_through():
     assert result["stats"]["status"] == "ok"
     t = np.array(result["t"])
     np.testing.assert_allclose(result["q"]["x"], oscillator(1.5, 0.0, t), atol=1e-6)
+
+
+# --- reasons that are true: k = 0, g = 1e308 ----------------------------------------------------
+
+
+def test_a_spring_with_zero_stiffness_leaves_a_free_particle():
+    """k = 0: no force at all, x = x₀ + v₀ t (it was said to give an 'overflow' reason)."""
+    spec = spring_spec(["x", "y"], 0.5, {"x": 1.0, "x_dot": 0.3, "y_dot": -0.2})
+    result = simulate(scene=spec, request=request(t_end=2.0, fps=10, parameters={"k": 0.0}))
+    assert result["stats"]["status"] == "ok"
+    t = np.array(result["t"])
+    np.testing.assert_allclose(result["q"]["x"], 1.0 + 0.3 * t, atol=1e-9)
+    np.testing.assert_allclose(result["q"]["y"], -0.2 * t, atol=1e-9)
+    assert result["warnings"] == []
+
+
+@pytest.mark.parametrize("scene", ["simple_pendulum", "incline_friction", "atwood_machine"])
+def test_an_overflowing_gravity_is_refused_naming_it_and_saying_overflow(scene):
+    """g = 1e308: q̈ is finite at the start (g sin θ₀ < 1.8e308) and the first step overflows.
+    It answered a one-sample 'partial' run ('the right-hand side became non-finite at
+    t = 3.46e-323 s'); the reason is the size of g, named as a start that overflows is."""
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    with TestClient(app) as client:
+        r = client.post(
+            "/api/v1/simulate", json={"scene_id": scene, "parameters": {"g": 1e308}, "t_end": 2}
+        )
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["field"] == "parameters.g"
+    assert "overflow" in error["message"] and "g = 1e+308" in error["message"]
+    assert "friction" not in error["message"].lower()
+
+
+def test_an_ordinary_blow_up_is_not_blamed_on_the_units():
+    """ẍ = x²: from x₀ = 1 at rest it reaches infinity in finite time, for ordinary numbers;
+    the run says where it stopped and names no parameter."""
+    spec = {
+        "coordinates": ["x"],
+        "parameters": {"m": 1.0},
+        "bodies": [{"name": "b", "mass": "m", "position": ["x", 0, 0]}],
+        "potentials": [{"name": "cubic", "expression": "-m*x**3/3"}],
+        "initial": {"x": 1.0},
+    }
+    result = simulate(scene=spec, request=request(t_end=5.0, fps=10))
+    assert result["stats"]["status"] != "ok"
+    assert not any("overflows double precision" in w for w in result["warnings"])
