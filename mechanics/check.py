@@ -683,7 +683,7 @@ class _Judge:
 
     # -- what is wrong ---------------------------------------------------------------------
     def _diagnose(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:
-        small_angle = self._small_angle(given, expected)
+        small_angle = self._small_angle(given, expected) or self._linearised(given, expected)
         if small_angle:
             fb.append(small_angle)
             fb += self._units(given)
@@ -801,6 +801,40 @@ class _Judge:
             f"{kept}."
         )
 
+    def _linearised(self, given: sp.Expr, expected: sp.Expr) -> str:
+        """A sentence when the answer is the derived result's Taylor polynomial at rest in the
+        angles: to first order in q, q̇, q̈ for an equation, q̈ or Q (the linearised equation,
+        where sin(θ₁ − θ₂) θ̇₂² is second order and goes), to second order in q, q̇ for T, V, L.
+        The match is proved; "" if there is none."""
+        trig = [f for f in expected.atoms(sp.sin, sp.cos, sp.tan) if f.args[0].has(*self.m.q)]
+        angles = [q for q in self.m.q if any(f.has(q) for f in trig)]
+        if not angles or sp.count_ops(expected) > PROOF_OPS:
+            return ""
+        g, e = self._canonical(given), self._canonical(expected)
+        if len(g) + len(e) > MAX_TERMS or set(g) <= set(e):
+            return ""  # nothing approximated, only terms left out: 'Missing term' says it
+        energy = self.quantity in ("T", "V", "L")
+        to_sym, back = _symbols_for(self.m)
+        small = [to_sym[x] for x in (*angles, *self.m.qd, *([] if energy else self.m.qdd))]
+        eps = sp.Dummy("eps")
+        scaled = expected.xreplace(to_sym).xreplace({x: eps * x for x in small})
+        taylor, term = sp.S.Zero, scaled
+        for k in range(3 if energy else 2):
+            taylor += term.subs(eps, 0) / sp.factorial(k)
+            term = term.diff(eps)
+        taylor = taylor.xreplace(back)
+        same = constant_proof if self.quantity in ("V", "L") else zero_proof
+        if same(given - taylor, self.m) is not True or same(expected - taylor, self.m) is True:
+            return ""
+        where = " = ".join([*(inline(q)[1:-1] for q in angles), "0"])
+        kept = ", ".join(inline(f) for f in sorted(trig, key=sp.default_sort_key))
+        order = "to second order" if energy else "the linearised equation: to first order"
+        return (
+            f"This is the small-angle approximation of the right answer ({order} in the angles "
+            f"and their rates): valid only for small swings, near ${where}$, not in general. "
+            f"The exact answer keeps {kept}."
+        )
+
     def _approximate(self, e: sp.Expr, order: int) -> tuple[sp.Expr, dict[sp.Expr, sp.Expr]]:
         """``e`` with sin, cos, tan of the coordinates replaced by their Taylor polynomials at
         0: sin x ≈ x, tan x ≈ x, and cos x ≈ 1 (order 1) or 1 − x²/2 (order 2)."""
@@ -833,7 +867,10 @@ class _Judge:
         if not e:
             if not g or whole_g.is_Add:
                 return []
-            return [f"Extra term {inline(whole_g)}: the correct answer has none like it."]
+            written = self._written_as(g)
+            return [
+                f"Extra term {written or inline(whole_g)}: the correct answer has none like it."
+            ]
         if whole_e.is_Add or (len(e) == 1 and len(g) <= 1):
             return []  # one piece each (or a sum): the piece by piece lines say it as well
         if not g:
@@ -858,6 +895,14 @@ class _Judge:
         return [
             f"Your {inline(velocity)} term is {inline(whole_g)}; it should be {inline(whole_e)}."
         ]
+
+    def _written_as(self, pieces: dict[sp.Expr, sp.Expr]) -> str:
+        """The student's own term whose canonical pieces these are, as typed: e^{−10⁶ (θ − 0.3)²},
+        not the e^{600000 θ} e^{−10⁶ θ²}/e^{90000} that expanding it makes. "" if none is."""
+        for term in self._surface(self.given):
+            if _expansion_size(term, MAX_TERMS) <= MAX_TERMS and self._canonical(term) == pieces:
+                return _as_written(term)
+        return ""
 
     @staticmethod
     def _functions(e: sp.Expr) -> set[sp.Expr]:

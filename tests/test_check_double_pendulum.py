@@ -115,3 +115,23 @@ def test_a_wrong_small_angle_form_is_not_excused_as_an_approximation():
     """−g/l θ with the wrong sign is no approximation of −g/l sin θ: a sign error."""
     v = check(derivation_of_scene("simple_pendulum"), "accel", "g/l*theta", "theta")
     assert not any("small-angle" in f for f in v.feedback), v.feedback
+
+
+def test_the_linearised_equation_of_motion_is_called_an_approximation():
+    """θ₁'s equation, by hand from L: (m₁ + m₂) l₁² θ̈₁ + m₂ l₁ l₂ cos(θ₁ − θ₂) θ̈₂
+    + m₂ l₁ l₂ sin(θ₁ − θ₂) θ̇₂² + (m₁ + m₂) g l₁ sin θ₁ = 0; to first order in θ, θ̇, θ̈ the
+    θ̇₂² term goes and cos → 1, sin θ₁ → θ₁."""
+    d = derivation_of_scene("double_pendulum")
+    exact = (
+        "(m1+m2)*l1**2*theta1_ddot + m2*l1*l2*cos(theta1-theta2)*theta2_ddot"
+        " + m2*l1*l2*sin(theta1-theta2)*theta2_dot**2 + (m1+m2)*g*l1*sin(theta1) = 0"
+    )
+    assert check(d, "eom", exact, "theta1").correct is True
+    linear = "(m1+m2)*l1**2*theta1_ddot + m2*l1*l2*theta2_ddot + (m1+m2)*g*l1*theta1 = 0"
+    v = check(d, "eom", linear, "theta1")
+    assert v.correct is False
+    assert len(v.feedback) == 1 and "linearised equation" in v.feedback[0], v.feedback
+    assert r"\theta_{1} = \theta_{2} = 0" in v.feedback[0]
+    # the linearised equation with a slip in it is no approximation: the slip is named
+    slipped = "(m1+m2)*l1**2*theta1_ddot + m2*l1*l2*theta2_ddot + m2*g*l1*theta1 = 0"
+    assert not any("approximation" in f for f in check(d, "eom", slipped, "theta1").feedback)
