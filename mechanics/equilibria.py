@@ -199,6 +199,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         results.append(_result_json(m, root, free, verdict, q0))
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
+    results, verdicts = _one_per_configuration(m, results, verdicts, values, warnings)
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
     families += [v.family for v in verdicts if v.family and v.family not in families]
     steps.append(_stability_step(results, verdicts))
@@ -215,6 +216,62 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     elif not dry and not any(w.startswith(_EDGE) for w in warnings):
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+#: The order in which one configuration's verdicts are kept: the most cautious first.
+_CAUTION = ("unstable", "marginal", "gyroscopically stable", "stable", "asymptotically stable")
+
+
+def _one_per_configuration(m, results, verdicts, values, warnings):
+    """Coordinates that name the same configuration twice (θ = 0 of a sphere with any φ): one
+    entry, with the most cautious verdict among them. Where the potential depends on φ the
+    search found the pole at a dozen φ, each linearized in θ along its own φ only ('stable' at
+    one, 'unstable' at another, for one point). Only for particles, whose positions are the
+    whole configuration (a rigid body's orientation is not in its position)."""
+    if len(results) < 2 or any(b.kind != "particle" for b in m.bodies):
+        return results, verdicts
+    groups: list[tuple[tuple, list[int]]] = []
+    for i, r in enumerate(results):
+        where = _configuration(m, [r["q"][n] for n in m.coordinate_names], values)
+        if where is None:
+            return results, verdicts
+        for key, members in groups:
+            scale = max(1.0, *map(abs, key), *map(abs, where))
+            if all(abs(a - b) <= 1e-9 * scale for a, b in zip(key, where, strict=True)):
+                members.append(i)
+                break
+        else:
+            groups.append((where, [i]))
+    if len(groups) == len(results):
+        return results, verdicts
+    kept = []
+    for _, members in groups:
+        best = min(members, key=lambda i: (_CAUTION.index(verdicts[i].kind), members.index(i)))
+        kept.append(best)
+        if len(members) > 1:
+            r = results[best]
+            warnings.append(
+                f"{len(members)} equilibria found name one configuration (a pole of the "
+                "coordinates, where one of them is undefined): listed once, at "
+                + ", ".join(f"{k} = {x:.4g}" for k, x in r["q"].items())
+                + f", with the most cautious verdict among them ({verdicts[best].kind})."
+            )
+    kept.sort()
+    return [results[i] for i in kept], [verdicts[i] for i in kept]
+
+
+def _configuration(m: Any, q0: list[float], values: dict) -> tuple[float, ...] | None:
+    """Every body's position at q0 (t = 0), as numbers; None where one is not a number."""
+    at = {**values, **{q: sp.Float(x) for q, x in zip(m.q, q0, strict=True)}}
+    at[m.names["t"]] = sp.S.Zero
+    out = []
+    for b in m.bodies:
+        for component in b.position.to_matrix(m.N):
+            try:
+                out.append(float(sp.S.Zero + component.xreplace(at).evalf()))
+            except (TypeError, ValueError):
+                return None
+    return tuple(out)
 
 
 def _point_text(m: Any, q0: list[float]) -> str:
