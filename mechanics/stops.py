@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from mechanics.integrators import _PHYSICAL, METHODS, Trajectory
+from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.numeric import CompiledScene, evaluate
 from mechanics.spec import SpecError
 
@@ -301,10 +301,45 @@ def first_stop(
     found = _locate(c, t0, y0, t1, params, req)
     if found is None and first is not None:  # not located: the condition became undefined
         found = first, *_first_undefined(c, first, params, t0, y0, t1)
+    if found is None and run.status != "ok":  # a fixed step may land past a domain's end
+        found = _domain_end(c, params, run, t0, y0, t1)
     if found is None:
         return None
     stop, t_stop, y_stop = found
     return _cut(run, k, stop, t_stop, y_stop)
+
+
+def _domain_end(c: CompiledScene, params: list[float], run: Any, t0, y0: np.ndarray, t1: float):
+    """A domain's end in (t0, t1] that a run ending early there did not see: its steps (a fixed
+    step of rk4) landed past it, where the right-hand side is NaN, and a tangential approach
+    (x = l sin√θ touches θ = 0) changes no sign for the event search. Stepped again, tightly and
+    watched, the steps creep into it as `StopWatch` expects."""
+    if not any(stop.kind == "domain" for stop in c.stops) or not t1 > t0:
+        return None
+    watch = StopWatch(c, params, np.asarray(y0, dtype=float))
+    watch.last = (t0, np.array(y0, dtype=float), watch._values(t0, np.asarray(y0)))
+    for i, stop in enumerate(c.stops):  # "near 0" is relative to the whole run's values
+        value, _ = _stop_values(c, stop, run.t, run.y, params)
+        finite = np.abs(value[np.isfinite(value)])
+        watch.scale[i] = max(watch.scale[i], float(finite.max()) if len(finite) else 0.0)
+    try:
+        with np.errstate(all="ignore"):
+            integrate(
+                c.rhs(params),
+                np.asarray(y0, dtype=float),
+                np.array([t0, t1]),
+                method="DOP853",
+                rtol=1e-10,
+                atol=1e-12,
+                second_order=c.n,
+                max_wall_time=2.0,
+                watch=watch,
+            )
+    except (ValueError, *_PHYSICAL):
+        return None
+    if watch.hit is None or c.stops[watch.hit[0]].kind != "domain":
+        return None
+    return watch.secant(params)
 
 
 def _cut(run: Any, k: int, stop: Any, t_stop: float, y_stop: np.ndarray) -> StopEvent:

@@ -275,6 +275,22 @@ def test_a_bead_on_a_parabola_in_a_folded_coordinate_stops_at_the_vertex(method)
     assert not any("drifted" in w for w in result["warnings"])
 
 
+@pytest.mark.parametrize("method", ["DOP853", "dop853_c", "rk4"])
+def test_a_pendulum_in_the_square_of_its_angle_stops_where_the_angle_reaches_zero(method):
+    """x = l sin√θ, y = −l cos√θ is the pendulum in φ = √θ (T = ½ m l² φ̇²), folded: θ = φ²
+    touches 0 where φ passes 0, never changes sign there, and cannot go on. The stop is at the
+    hand-written pendulum's first zero of φ from φ₀ = √θ₀, φ̇₀ = θ̇₀/(2√θ₀). It ran on, or
+    (rk4) ended 'non-finite' with no reason."""
+    theta0, omega0 = 0.5, -1.0
+    phi0, phidot0 = math.sqrt(theta0), omega0 / (2 * math.sqrt(theta0))
+    spec = pendulum(position=["l*sin(sqrt(theta))", "-l*cos(sqrt(theta))", 0])
+    result = simulate(scene=spec, request=request(method, initial={"theta_dot": omega0}))
+    stop = result["stats"]["stop"]
+    assert stop["name"] == "bob_domain_end"
+    tol = 1e-5 if method != "rk4" else 1e-4  # rk4 at dt = 1e-3 stops a step's error away
+    assert stop["t"] == pytest.approx(first_zero(phi0, phidot0), abs=tol)
+
+
 def test_a_position_whose_root_never_ends_has_no_domain_stop():
     """√(l² + θ²) is defined for every θ: no stop, and the pendulum-like run is ok."""
     spec = pendulum(position=["l*sin(theta)", "-sqrt(l**2 + theta**2)", 0])
