@@ -469,7 +469,7 @@ def _stop_value(expr: Any, st: Any, i: int, names: dict[str, sp.Expr]) -> sp.Exp
     return value
 
 
-_ROOTS = "a fractional power (a square root) of a negative number"
+_ROOTS = "a square root (or a fractional power) of a negative number"
 
 
 def _domain_ends(value: sp.Expr) -> list[tuple[sp.Expr, str]]:
@@ -515,9 +515,9 @@ def _domain_stops(
             stops.append(
                 StopInfo(
                     f"{what[1]}_domain_end" + (f"{len(seen)}" if len(seen) > 1 else ""),
-                    f"{what[0]} is undefined past {to_plain(end)} = 0 ({why} in {where}): "
-                    "the state would have left the domain of its position function, so the "
-                    "model ends there",
+                    f"{what[0]} is undefined past {to_plain(end)} = 0 ({where} would take "
+                    f"{why}): the state would have left the domain of its position function, "
+                    "so the model ends there",
                     end,
                     kind="domain",
                 )
