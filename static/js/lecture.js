@@ -1,5 +1,8 @@
 // Lecture mode: large type and high contrast for a projector, the derivation revealed one step at a
 // time (→, space, PageDown reveal the next; ←, PageUp hide it), p plays or pauses, f full screen.
+// A step taller than the screen (a double pendulum's Euler–Lagrange step is three screens) is paged
+// through first: the same keys scroll it a screen at a time before the next step is revealed, and
+// the counter says when more of it lies below.
 // The derivation stands beside the animation, so in lecture mode it is moved next to it in the
 // page too: the tab order and a screen reader follow what the room sees. Its equations are fitted
 // to the narrower column (fit.js).
@@ -18,6 +21,12 @@ export class Lecture {
     watchEquations(list);
     if (toggle) toggle.addEventListener("click", () => this.set(!this.on));
     document.addEventListener("keydown", (e) => this.#key(e));
+    let queued = false;
+    window.addEventListener("scroll", () => {
+      if (queued || !this.on) return;
+      queued = true;
+      requestAnimationFrame(() => { queued = false; this.#count(); });
+    }, { passive: true });
   }
 
   get on() {
@@ -57,19 +66,98 @@ export class Lecture {
       else document.documentElement.requestFullscreen?.().catch(() => {});
     } else if (this.on && ["ArrowRight", " ", "PageDown"].includes(e.key)) {
       e.preventDefault();
-      this.step(+1);
+      this.forward();
     } else if (this.on && ["ArrowLeft", "PageUp"].includes(e.key)) {
       e.preventDefault();
-      this.step(-1);
+      this.back();
     }
+  }
+
+  /** Key presses one after another, each once the equations it shows are fitted (fit.js breaks
+   * a revealed step's wide equations after it is shown, which moves what lies below);
+   * `data-lecture-busy` on <html> counts those still to run. */
+  #then(action) {
+    const root = document.documentElement;
+    root.dataset.lectureBusy = String(Number(root.dataset.lectureBusy || 0) + 1);
+    this.queue = (this.queue || Promise.resolve()).then(action).catch(() => {}).finally(() => {
+      root.dataset.lectureBusy = String(Number(root.dataset.lectureBusy) - 1);
+    });
+    return this.queue;
+  }
+
+  /** The next screen of the current step while it runs on below the screen, else the next step. */
+  forward() {
+    return this.#then(() => this.#forward());
+  }
+
+  back() {
+    return this.#then(() => this.#back());
+  }
+
+  #forward() {
+    const current = this.#current();
+    const rest = current?.getBoundingClientRect();
+    if (rest && rest.bottom > innerHeight + 2) {
+      // the first line cut by the screen's bottom edge goes to the top (so every line shorter
+      // than the screen is once seen whole), at most a screen at a time
+      const top = this.#headerBottom(), page = this.#page();
+      const cut = [...current.querySelectorAll(".math-line, p, h3, figure, summary, tr")]
+        .filter(shown).map((b) => b.getBoundingClientRect())
+        .find((r) => r.height > 0 && r.bottom > innerHeight + 1 && r.top > top + 1);
+      // (a line cut already at the top is taller than the screen: a whole screen of it then)
+      const line = parseFloat(getComputedStyle(document.documentElement).fontSize) || 16;
+      const by = cut && cut.top - top - 8 > 2 * line ? Math.min(cut.top - top - 8, page) : page;
+      window.scrollBy(0, Math.min(by, rest.bottom - innerHeight + 16));
+    } else {
+      return this.step(+1);
+    }
+    this.#count();
+  }
+
+  /** The screen above while the current step began above it, else hide the current step. */
+  #back() {
+    const rest = this.#current()?.getBoundingClientRect();
+    const top = this.#headerBottom();
+    if (rest && rest.top < top - 2) window.scrollBy(0, -Math.min(this.#page(), top - rest.top + 8));
+    else return this.step(-1);
+    this.#count();
   }
 
   step(delta) {
     this.revealed += delta;
-    this.apply(true);
+    return this.apply(delta < 0 ? "end" : true);
   }
 
-  /** Show the first `revealed` steps (all of them outside lecture mode). */
+  #current() {
+    return this.list.querySelectorAll(":scope > .step")[this.revealed - 1] || null;
+  }
+
+  /** Below the sticky header: what of the page the room can read. */
+  #headerBottom() {
+    const header = document.querySelector("body > header");
+    return header && getComputedStyle(header).position === "sticky" ? header.getBoundingClientRect().bottom : 0;
+  }
+
+  /** A screen, less two lines kept from the last one so the room does not lose its place. */
+  #page() {
+    const line = parseFloat(getComputedStyle(document.documentElement).fontSize) || 16;
+    return Math.max(line * 4, innerHeight - this.#headerBottom() - 3 * line);
+  }
+
+  /** "step 6 of 8", and "· more below ↓" while the current step runs on past the screen. */
+  #count() {
+    const steps = this.list.querySelectorAll(":scope > .step");
+    if (!this.counter) return;
+    if (!steps.length) { this.counter.textContent = ""; return; }
+    const rest = this.on ? this.#current()?.getBoundingClientRect() : null;
+    const more = Boolean(rest && rest.bottom > innerHeight + 2);
+    this.counter.textContent = `step ${this.revealed} of ${steps.length}${more ? " · more below ↓" : ""}`;
+    this.counter.dataset.more = String(more);
+  }
+
+  /** Show the first `revealed` steps (all of them outside lecture mode); `scroll` brings the
+   * current one into view, its start (a step just revealed) or its end ("end": back from the
+   * next step, where the room left it). */
   apply(scroll = false) {
     const steps = [...this.list.querySelectorAll(":scope > .step")];
     this.revealed = Math.max(1, Math.min(this.revealed, steps.length || 1));
@@ -78,9 +166,27 @@ export class Lecture {
       s.classList.toggle("current", this.on && k === this.revealed - 1);
     });
     this.list.dataset.revealed = String(this.on ? this.revealed : steps.length);
-    if (this.counter) this.counter.textContent = steps.length ? `step ${this.revealed} of ${steps.length}` : "";
     const last = steps[this.revealed - 1];
-    if (scroll && this.on && last) last.scrollIntoView({ block: "nearest", behavior: "smooth" });
-    fitEquations(this.list); // a step just shown is measured only now
+    this.#count();
+    return fitEquations(this.list).then(() => { // a step just shown is measured only now
+      if (!scroll || !this.on || !last) return;
+      // a step just revealed starts under the header (all of it when it fits below what is shown)
+      const r = last.getBoundingClientRect(), top = this.#headerBottom();
+      if (scroll === "end" && (r.bottom > innerHeight || r.bottom < top)) {
+        window.scrollBy(0, Math.max(r.bottom - innerHeight + 16, r.top - top - 8));
+      } else if (scroll !== "end" && (r.top < top || r.bottom > innerHeight)) {
+        window.scrollBy(0, r.top - top - 8);
+      }
+      this.#count();
+    });
   }
+}
+
+/** Not folded away: a closed <details> keeps its contents' last geometry (Chromium lays them out
+ * as content-visibility: hidden), so their rectangles say nothing of what is on screen. */
+function shown(el) {
+  for (let d = el.closest("details"); d; d = d.parentElement?.closest("details")) {
+    if (!d.open && !(el.closest("summary")?.parentElement === d)) return false;
+  }
+  return true;
 }

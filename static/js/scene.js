@@ -95,7 +95,8 @@ class SceneView {
     this.#playback();
     this.lecture = new Lecture({
       list: $("steps"), toggle: $("lecture-toggle"), counter: $("step-counter"),
-      onToggle: () => { this.#saveURL(); this.#plot(); }, onPlay: () => this.togglePlay(),
+      onToggle: () => { this.#saveURL(); this.#plot(); this.#label(this.shown); },
+      onPlay: () => this.togglePlay(),
     });
     // a share link's lecture step (0: the first), revealed once the steps are there
     const step = query.has("step") ? Number(query.get("step")) : NaN;
@@ -275,8 +276,8 @@ class SceneView {
         this.shown = null;
         this.#waiting("No motion: the server refused this state (see the warnings).");
         this.#label(null);
-        this.#syncPlay();
       }
+      this.#syncPlay(); // nothing on the canvas: 'no run', not '… computing' for ever
     } finally {
       if (id === this.runs) {
         $("stats").classList.remove("busy");
@@ -346,7 +347,11 @@ class SceneView {
       const s = this.settings;
       const how = isFixed(st.method) ? `dt = ${s.dt} s` : `rtol = atol = ${s.tol}`;
       const drawn = st.display_factor > 1 ? `; ${SERVER_FPS} samples/s, drawn at ${SERVER_FPS * st.display_factor} by interpolation` : "";
-      b.textContent = `server run (${st.method}, ${how}${drawn})`;
+      // in lecture mode (24 px type beside a narrow canvas) the short form: the full one pushed
+      // the play controls off a 1280×720 projector; the full one stays in its tooltip
+      b.textContent = document.body.classList.contains("lecture")
+        ? `server run (${st.method})` : `server run (${st.method}, ${how}${drawn})`;
+      b.title = `server run (${st.method}, ${how}${drawn})`;
       Object.assign(b.style, { background: "transparent", color: "inherit", borderColor: "transparent" });
     }
   }
@@ -402,7 +407,8 @@ class SceneView {
   /** 'Pause' only while something moves on the canvas: before the first run it says so. */
   #syncPlay() {
     const ready = Boolean(this.shown);
-    $("play").textContent = !ready ? "… computing" : this.playing ? "❚❚ Pause" : "▶ Play";
+    const refused = !ready && $("canvas").dataset.error !== undefined;
+    $("play").textContent = refused ? "no run" : !ready ? "… computing" : this.playing ? "❚❚ Pause" : "▶ Play";
     $("play").setAttribute("aria-pressed", String(this.playing && ready));
   }
 

@@ -111,11 +111,18 @@ def open_scene(p, server: str, scene: str, query: str = "") -> None:
     )
 
 
+LECTURE_IDLE = "() => (document.documentElement.dataset.lectureBusy || '0') === '0'"
+
+
 def reveal_all(p) -> None:
+    """→ until every step is shown (a step taller than the screen takes a press per screen)."""
     n = p.locator("#steps > .step").count()
-    for _ in range(n):
+    for _ in range(20 * n):
+        if p.get_attribute("#steps", "data-revealed") == str(n):
+            return
         p.keyboard.press("ArrowRight")
-    p.wait_for_function(f"() => document.getElementById('steps').dataset.revealed === '{n}'")
+        p.wait_for_function(LECTURE_IDLE)
+    raise AssertionError(f"{n} steps not revealed by → after {20 * n} presses")
 
 
 def assert_fits(p, where: str) -> None:
@@ -154,11 +161,19 @@ def test_lecture_keys_reveal_one_step_each(server, page, sized):
     open_scene(p, server, "double_pendulum", "?lecture=1")
     revealed = lambda: int(p.evaluate("document.getElementById('steps').dataset.revealed"))  # noqa: E731
     assert revealed() == 1
-    for k, key in enumerate(["ArrowRight", " ", "PageDown"], start=2):
+    # each key moves on: a screen further through a step taller than the screen, else one step
+    for key in ["ArrowRight", " ", "PageDown"] * 3:
+        before = (revealed(), p.evaluate("scrollY"))
         p.keyboard.press(key)
-        p.wait_for_function(f"() => document.getElementById('steps').dataset.revealed === '{k}'")
-    p.keyboard.press("ArrowLeft")
-    assert revealed() == 3
+        p.wait_for_function(LECTURE_IDLE)
+        after = (revealed(), p.evaluate("scrollY"))
+        assert after[0] == before[0] + 1 or (after[0] == before[0] and after[1] > before[1])
+    reached = revealed()
+    assert reached >= 3
+    for _ in range(10):  # ← goes back the same way, and hides the steps again
+        p.keyboard.press("ArrowLeft")
+        p.wait_for_function(LECTURE_IDLE)
+    assert revealed() < reached
     # the derivation sits beside the animation, and so it comes right after it in the page
     order = p.evaluate(
         "[...document.querySelector('.scene-layout').children].map((c) => c.className)"
