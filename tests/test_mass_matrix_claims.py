@@ -14,9 +14,12 @@ EVERYWHERE = "positive definite at every configuration"
 rng = np.random.default_rng(7)
 
 
+def _matrix_step(scene_id: str):
+    return next(s for s in derivation_of(scene_id, None).steps if s.id == "matrix")
+
+
 def _matrix_text(scene_id: str) -> str:
-    d = derivation_of(scene_id, None)
-    return next(s.text for s in d.steps if s.id == "matrix")
+    return _matrix_step(scene_id).text
 
 
 def _double_pendulum_det(m1, m2, l1, l2, th1, th2):
@@ -54,9 +57,11 @@ def test_definite_everywhere_is_said_only_where_it_holds(scene_id, det):
 
 def test_a_spherical_pendulum_is_not_called_definite_at_its_poles():
     assert _spherical_det(1.0, 1.0, 0.0) == 0.0  # by hand: M singular at θ = 0
-    text = _matrix_text("spherical_pendulum")
-    assert EVERYWHERE not in text
-    assert "semidefinite" in text and r"\neq 0" in text and r"\sin^{2}" in text
+    step = _matrix_step("spherical_pendulum")
+    assert EVERYWHERE not in step.text
+    assert "semidefinite" in step.text and r"\neq 0" in step.text
+    [det] = [line for line in step.lines if line.label == "det M"]
+    assert r"\sin^{2}" in det.latex  # the determinant it points to, shown below
 
 
 def test_a_posted_polar_particle_says_where_m_is_definite():
@@ -76,5 +81,6 @@ def test_a_posted_polar_particle_says_where_m_is_definite():
     with TestClient(app) as c:
         r = c.post("/api/v1/derive", json={"scene": spec})
     assert r.status_code == 200, r.text
-    text = next(s["text"] for s in r.json()["steps"] if s["id"] == "matrix")
-    assert EVERYWHERE not in text and "r^{2}" in text, text
+    step = next(s for s in r.json()["steps"] if s["id"] == "matrix")
+    assert EVERYWHERE not in step["text"], step["text"]
+    assert any(tex.startswith(r"\det") and "r^{2}" in tex for tex in step["latex"]), step["latex"]

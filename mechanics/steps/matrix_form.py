@@ -41,7 +41,11 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
             )
         else:
             det = determinant(M, model)
-    text += definiteness(det, model)
+    text += definiteness(det, model, listed=det is not None and len(M) > 1)
+    if det is not None and len(M) > 1:
+        lines.append(
+            Line("det M", rf"\det \mathbf{{M}} = {to_latex(det)}", f"det(M) = {to_plain(det)}")
+        )
     if det is not None:
         work.accelerations = solve_accelerations(M, f, model, det)
         for name, qdd, acc in zip(
@@ -56,26 +60,19 @@ def determinant(M: sp.Matrix, model: Model) -> sp.Expr:
     return tidy(M.det(method="berkowitz"), model, collect_velocities=False)
 
 
-def definiteness(det: sp.Expr | None, model: Model) -> str:
+def definiteness(det: sp.Expr | None, model: Model, listed: bool) -> str:
     """What the step may say of M: T ≥ 0 makes it positive semidefinite everywhere, but only a
     nonzero det M makes it definite, and spherical or polar coordinates lose that at their poles
     (a spherical pendulum's det M = l⁴m² sin²θ), where q̈ is not defined."""
     if det is not None and _positive(det, model):
         return (
             r"$\mathbf M$ is symmetric and positive definite at every configuration: "
-            rf"$\det \mathbf M = {to_latex(det)} > 0$ for positive masses and lengths."
-            if len(to_latex(det)) <= 200
-            else r"$\mathbf M$ is symmetric and positive definite at every configuration "
-            r"($\det \mathbf M > 0$ for positive masses and lengths)."
+            r"$\det \mathbf M > 0$ for positive masses and lengths."
         )
-    where = (
-        rf"$\det \mathbf M = {to_latex(det)} \neq 0$"
-        if det is not None and len(to_latex(det)) <= 200
-        else r"$\det \mathbf M \neq 0$"
-    )
     return (
         r"$\mathbf M$ is symmetric and positive semidefinite (as $T \ge 0$); it is positive "
-        rf"definite, so that $\ddot q$ is defined, wherever {where}."
+        r"definite, so that $\ddot q$ is defined, wherever $\det \mathbf M \neq 0$"
+        + (" (below)." if listed else ".")
     )
 
 
