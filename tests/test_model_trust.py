@@ -163,3 +163,16 @@ def test_an_ordinary_blow_up_is_not_blamed_on_the_units():
     result = simulate(scene=spec, request=request(t_end=5.0, fps=10))
     assert result["stats"]["status"] != "ok"
     assert not any("overflows double precision" in w for w in result["warnings"])
+
+
+def test_a_zero_rest_length_spring_at_its_anchor_raises_no_warning():
+    """V = ½ k x² is smooth at the anchor: no 'it has no direction' warning when the spec's own
+    state starts there with ℓ₀ = 0; a stretched spring (ℓ₀ = 0.5) at its anchor keeps it."""
+    from mechanics.derive import derive_model
+
+    def warnings(rest_length: float) -> list[str]:
+        spec = spring_spec(["x"], rest_length, {"x": 0.0, "x_dot": 2.0})
+        return [w for w in derive_model(spec).work.warnings if "at its anchor" in w]
+
+    assert warnings(0.0) == []
+    assert len(warnings(0.5)) == 1

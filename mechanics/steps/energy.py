@@ -58,7 +58,9 @@ def energies(model: Model, work: Work) -> Step:
             "when that state is at the anchor). A run that starts on the other side is derived "
             "with the opposite sign, and one that reaches ℓ = 0 stops there."
         )
-        if reference_value(s.branch, model.spec, model.names) == 0:
+        # (with a rest length of 0 at the spec's values, V = ½ k p² is smooth through the anchor)
+        at_anchor = reference_value(s.branch, model.spec, model.names) == 0
+        if at_anchor and reference_value(s.rest_length, model.spec, model.names) != 0:
             work.warnings.append(
                 f"The spec's initial state puts the spring {s.name} at its anchor (ℓ = 0), where "
                 "it has no direction: give `initial` a state off the anchor to simulate it."
