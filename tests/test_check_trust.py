@@ -212,6 +212,16 @@ def test_a_tiny_power_is_decided_without_expanding_it(answer):
     assert "not zero" in v.feedback[0] and "factor" not in v.feedback[0], v.feedback
 
 
+@pytest.mark.timeout(60)
+def test_a_high_degree_identity_is_proved_quickly():
+    """(sin² 8θ + cos² 8θ)⁸ = 1: a polynomial of degree 128 in sin θ, cos θ once sin 8θ is
+    expanded (21 s to normalise); exact evaluation proves it at once."""
+    started = time.perf_counter()
+    v = verdict(f"{T_PENDULUM} * (sin(8*theta)**2 + cos(8*theta)**2)**8")
+    assert v.correct is True, v.feedback
+    assert time.perf_counter() - started < 3
+
+
 def test_a_multiple_angle_identity_in_two_coordinates_is_proved():
     """sin²(3θ₁ − 5θ₂) + cos²(3θ₁ − 5θ₂) = 1, cubed, on the double pendulum's cross term."""
     answer = (
