@@ -4,6 +4,7 @@ via /api/v1). Every page answers ``HEAD`` too (app/middleware.py)."""
 from __future__ import annotations
 
 import logging
+import re
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -60,8 +61,33 @@ def inline_json(data: bytes) -> str:
     return text
 
 
+_LOWER = "alpha beta gamma delta epsilon zeta eta theta iota kappa lambda mu nu xi pi rho sigma tau"
+_GREEK = dict(
+    zip((_LOWER + " upsilon phi chi psi omega").split(), "αβγδεζηθικλμνξπρστυφχψω", strict=True)
+)
+_GREEK |= dict(
+    zip("Gamma Delta Theta Lambda Xi Pi Sigma Phi Psi Omega".split(), "ΓΔΘΛΞΠΣΦΨΩ", strict=True)
+)
+_NAME = re.compile(r"([A-Za-z]+?)_?(\d*)")
+
+
+def symbol(name: str) -> str:
+    """A coordinate's or parameter's name as a symbol where nothing typesets it (a catalog card):
+    theta1 -> θ₁, Omega -> Ω; any other name (x_cart) stays what the editor calls it. The same
+    rule as static/js/texnames.js nameText."""
+    m = _NAME.fullmatch(name)
+    if not m:
+        return name
+    stem, digits = m.groups()
+    base = _GREEK.get(stem) or (stem if len(stem) == 1 else None)
+    if base is None:
+        return name
+    return base + digits.translate(str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉"))
+
+
 templates = Jinja2Templates(directory=str(TEMPLATES_DIR), context_processors=[_page_context])
 templates.env.globals["asset"] = asset
+templates.env.filters["symbol"] = symbol
 templates.env.globals["module_preloads"] = module_preloads
 
 

@@ -1,6 +1,7 @@
 // A slider and a number box for every parameter and every initial q and q_dot, and the page state
 // in the URL query (?m=1.2&theta=0.5&method=rk4&dt=0.01), so a link reproduces a run exactly.
 
+import { nameText } from "./texnames.js";
 const SETTINGS = ["method", "method_b", "tol", "dt", "t_end", "compare", "lecture", "phase"];
 
 /** A sensible slider range for a value: [0, 3x] for a positive parameter, ±π for an angle. */
@@ -80,7 +81,9 @@ export function buildControls(box, rows, onChange, onCommit = () => {}) {
     row.innerHTML = `<label for="n-${name}"><span class="name"></span> <span class="unit"></span></label>
       <input id="s-${name}" type="range" aria-label="${name} slider">
       <input id="n-${name}" type="number" step="any">`;
-    row.querySelector(".name").textContent = name;
+    // the symbol (θ̇₁); the name the editor, the answers and the link use (theta1_dot) on hover
+    row.querySelector(".name").textContent = nameText(name);
+    row.querySelector("label").title = name;
     row.querySelector(".unit").textContent = unit || "";
     const slider = row.querySelector('input[type="range"]');
     const number = row.querySelector('input[type="number"]');

@@ -2,7 +2,7 @@
 // MathJax) with buttons to copy a line as LaTeX or as plain text, and "your turn" boxes that check
 // an answer typed in plain notation (POST /api/v1/check).
 import { postJSON, typeset } from "./api.js";
-import { dottedTex, inline, inlineMath, nameTex } from "./texnames.js";
+import { dottedTex, inline, inlineMath, labelText, nameTex } from "./texnames.js";
 
 const el = (tag, props = {}, ...children) => {
   const node = Object.assign(document.createElement(tag), props);
@@ -30,19 +30,22 @@ function renderStep(step, k, target, coordinates) {
     body.append(figure);
     for (const note of step.data?.constraints || []) words.append(el("p", { className: "note", textContent: inlineMath(note) }));
   }
-  step.latex.forEach((tex, j) => words.append(mathLine(tex, step.plain[j] ?? "", step.labels?.[j] ?? "")));
+  step.latex.forEach((tex, j) => words.append(mathLine(tex, step.plain[j] ?? "", step.labels?.[j] ?? "", coordinates)));
   body.prepend(words);
   li.append(body);
   for (const box of yourTurn(step.id, target, coordinates)) li.append(box);
   return li;
 }
 
-function mathLine(tex, plain, label) {
+/** One display equation with its tools; the engine's label (what provenance.js and page.js look
+ * lines up by) in data-label, and shown as symbols: "dL/dtheta_dot" reads ∂L/∂θ̇. */
+function mathLine(tex, plain, label, coordinates = []) {
   const row = el("div", { className: "math-line" });
+  row.dataset.label = label;
   const math = el("div", { className: "math", textContent: `\\[${tex}\\]` });
   math.dataset.latex = tex;
   const tools = el("div", { className: "line-tools" });
-  if (label) tools.append(el("span", { className: "line-label", textContent: label }));
+  if (label) tools.append(el("span", { className: "line-label", textContent: labelText(label, coordinates), title: label }));
   tools.append(copyButton("LaTeX", tex), copyButton("text", plain));
   row.append(math, tools);
   return row;

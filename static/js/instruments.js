@@ -7,6 +7,7 @@
 // , and . keys while paused). Built from JS next to the stage's canvas; styled inline, so the page's
 // stylesheet needs nothing new. Data attributes (data-value, data-t, data-period, ...) let the
 // browser tests read what is shown.
+import { nameText } from "./texnames.js";
 
 const NS = "http://www.w3.org/2000/svg";
 const BARS = [ // key in the run's `energy`, label, colour; the work bars only when the run has any
@@ -205,8 +206,8 @@ export class Instruments {
     const works = shown.filter(([, , , w]) => w).map(([, l]) => l);
     this.caption.textContent = "All bars on one axis, over the whole run. V's zero is arbitrary (where " +
       "the datum is put), so only changes in V and E mean something" +
-      (datum ? `; here from V's lowest value in this run, V_min = ${fmtJ(datum)} J: V′ = V − V_min, ` +
-        "E′ = E − V_min = T + V′, and every energy bar starts at 0." : ".") +
+      (datum ? `; here from V's lowest value in this run, min V = ${fmtJ(datum)} J: V′ = V − min V, ` +
+        "E′ = E − min V = T + V′, and every energy bar starts at 0." : ".") +
       (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.`
         : this.result.stats?.driven ? " A drive does work here; its bar comes with the server's run."
           : " No work is done from outside: E stays constant.");
@@ -306,7 +307,7 @@ export class Instruments {
     if (sw.kind !== "steady" && sw.kind !== "once") {
       // the whole run says there is no period: no number at any frame, only why
       out.textContent = "no period";
-      this.periodNote.textContent = `${name} ${sw.reason}${tail}`;
+      this.periodNote.textContent = `${nameText(name)} ${sw.reason}${tail}`;
       return;
     }
     const seen = sw.ups.filter(([k]) => k <= i);
@@ -318,7 +319,7 @@ export class Instruments {
       out.dataset.period = String(period);
     }
     const n = Math.max(0, seen.length - 1);
-    this.periodNote.textContent = `Counts ${name} rising through its mean over the run (${sw.mean.toFixed(3)})` +
+    this.periodNote.textContent = `Counts ${nameText(name)} rising through its mean over the run (${sw.mean.toFixed(3)})` +
       `: ${n} full period${n === 1 ? "" : "s"} so far` +
       (sw.kind === "once" ? "; the run holds one swing only, so it is not yet seen to repeat." : ".") + tail;
   }
@@ -382,7 +383,7 @@ export class Instruments {
     this.#buildBars();
     if (fresh) {
       const keep = this.periodQ.value;
-      this.periodQ.replaceChildren(...spec.coordinates.map((q) => new Option(q, q)));
+      this.periodQ.replaceChildren(...spec.coordinates.map((q) => new Option(nameText(q), q)));
       if (spec.coordinates.includes(keep)) this.periodQ.value = keep;
       else { // the first coordinate that swings with a period, if any does (φ of a cone orbits)
         const timed = spec.coordinates.find((q) => result.q?.[q] && ["steady", "once"].includes(swings(result.t, result.q[q]).kind));

@@ -72,7 +72,7 @@ function markStale() {
 
 // ------------------------------------------------------------------ "Your turn" withholds its answer
 
-/** The labels (derivation.js .line-label, the step's `labels`) of the lines that answer the k-th
+/** The labels (derivation.js's data-label, the step's `labels`) of the lines that answer the k-th
  * "Your turn" box of a step: the boxes come in derivation.js yourTurn's order (energy: T, V;
  * forces: Q_j per coordinate; lagrange: L, then the equation of motion per coordinate; matrix: q̈
  * per coordinate), and the coordinates in the order of the step's own labels. */
@@ -91,7 +91,7 @@ export function answerLabels(stepId, k, labels) {
   return [];
 }
 
-const labelOf = (line) => line.querySelector(".line-label")?.textContent.trim() || "";
+const labelOf = (line) => line.dataset.label || "";
 
 /** Hide, in one step, the answers of its open and not yet revealed boxes; show the rest. */
 function withhold(step) {

@@ -168,12 +168,12 @@ function panel(title, parts) {
   return box;
 }
 
-/** The line of a step with this label (derivation.js writes it in .line-label). */
+/** The line of a step with this label (derivation.js keeps it in data-label). */
 function lineOf(container, stepId, label) {
   const step = container.querySelector(`li[data-step="${stepId}"]`);
   if (!step) return null;
   const row = [...step.querySelectorAll(".math-line")]
-    .find((r) => r.querySelector(".line-label")?.textContent === label);
+    .find((r) => r.dataset.label === label);
   return row || null;
 }
 

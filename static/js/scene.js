@@ -10,6 +10,7 @@
 import { busy, getJSON, holdMathJax, postJSON, releaseMathJax, track, typeset } from "./api.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
 import { renderSteps } from "./derivation.js";
+import { nameText } from "./texnames.js";
 import { Stage } from "./draw.js";
 import { showEquilibria } from "./equilibria.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
@@ -130,7 +131,7 @@ class SceneView {
     $("scene-summary").textContent = spec.summary || "";
     if (!this.sceneId) $("scene-title").textContent = spec.title || "Your system";
     this.#controls();
-    $("phase-q").replaceChildren(...spec.coordinates.map((q) => new Option(q, q)));
+    $("phase-q").replaceChildren(...spec.coordinates.map((q) => new Option(nameText(q), q)));
     if (spec.coordinates.includes(this.phase)) $("phase-q").value = this.phase;
     this.result = null;
     this.resultB = null;

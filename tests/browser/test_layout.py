@@ -20,6 +20,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from lecture_keys import press, reveal_all
 
 pytestmark = pytest.mark.browser
 
@@ -111,20 +112,6 @@ def open_scene(p, server: str, scene: str, query: str = "") -> None:
     )
 
 
-LECTURE_IDLE = "() => (document.documentElement.dataset.lectureBusy || '0') === '0'"
-
-
-def reveal_all(p) -> None:
-    """→ until every step is shown (a step taller than the screen takes a press per screen)."""
-    n = p.locator("#steps > .step").count()
-    for _ in range(20 * n):
-        if p.get_attribute("#steps", "data-revealed") == str(n):
-            return
-        p.keyboard.press("ArrowRight")
-        p.wait_for_function(LECTURE_IDLE)
-    raise AssertionError(f"{n} steps not revealed by → after {20 * n} presses")
-
-
 def assert_fits(p, where: str) -> None:
     p.wait_for_function(FITTED, timeout=30_000)
     m = p.evaluate(OVERFLOWING)
@@ -164,15 +151,13 @@ def test_lecture_keys_reveal_one_step_each(server, page, sized):
     # each key moves on: a screen further through a step taller than the screen, else one step
     for key in ["ArrowRight", " ", "PageDown"] * 3:
         before = (revealed(), p.evaluate("scrollY"))
-        p.keyboard.press(key)
-        p.wait_for_function(LECTURE_IDLE)
+        press(p, key)
         after = (revealed(), p.evaluate("scrollY"))
         assert after[0] == before[0] + 1 or (after[0] == before[0] and after[1] > before[1])
     reached = revealed()
     assert reached >= 3
     for _ in range(10):  # ← goes back the same way, and hides the steps again
-        p.keyboard.press("ArrowLeft")
-        p.wait_for_function(LECTURE_IDLE)
+        press(p, "ArrowLeft")
     assert revealed() < reached
     # the derivation sits beside the animation, and so it comes right after it in the page
     order = p.evaluate(

@@ -7,6 +7,7 @@ controls on a 1280×720 screen."""
 from __future__ import annotations
 
 import pytest
+from lecture_keys import press
 
 pytestmark = pytest.mark.browser
 
@@ -19,12 +20,6 @@ SEEN = """() => {
     return r.height > 0 && r.top >= top - 1 && r.bottom <= innerHeight + 1 ? i : -1;
   }).filter((i) => i >= 0);
 }"""
-
-
-def _press(p, key: str) -> None:
-    """A key, then wait until the page has done what it asked (lecture.js queues presses)."""
-    p.keyboard.press(key)
-    p.wait_for_function("() => (document.documentElement.dataset.lectureBusy || '0') === '0'")
 
 
 @pytest.mark.parametrize("size", [(1280, 720), (1024, 768)])
@@ -45,7 +40,7 @@ def test_the_arrow_key_shows_every_equation_of_a_long_derivation(server, browser
                 p.inner_text("#step-counter")
             ):
                 break
-            _press(p, "ArrowRight")
+            press(p, "ArrowRight")
             seen |= set(p.evaluate(SEEN))
         missed = sorted(set(range(total)) - seen)
         assert not missed, f"{len(missed)} of {total} equation lines never on screen: {missed}"
@@ -56,7 +51,7 @@ def test_the_arrow_key_shows_every_equation_of_a_long_derivation(server, browser
             revealed, y = p.get_attribute("#steps", "data-revealed"), p.evaluate("scrollY")
             if revealed == "1" and y == 0:
                 break
-            _press(p, "ArrowLeft")
+            press(p, "ArrowLeft")
             same = p.get_attribute("#steps", "data-revealed") == revealed
             paged_back |= same and p.evaluate("scrollY") < y
         assert p.get_attribute("#steps", "data-revealed") == "1"

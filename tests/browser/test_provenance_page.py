@@ -64,9 +64,7 @@ def test_trace_terms_tables_and_hover(server, page, artifacts):
     origin = p.locator(f"li[data-step=energy] tbody[data-term='{via}']")
     assert "pv-from" in origin.get_attribute("class")
     # ... and the lines it stands on, step by step: v of the planet, T, d/dt ∂L/∂θ̇, the EoM.
-    lit = p.eval_on_selector_all(
-        ".math-line.pv-line", "rows => rows.map(r => r.querySelector('.line-label').textContent)"
-    )
+    lit = p.eval_on_selector_all(".math-line.pv-line", "rows => rows.map(r => r.dataset.label)")
     for label in ("v of planet", "T_planet", "T", "d/dt dL/dtheta_dot", "EoM theta"):
         assert label in lit, lit
     assert "V" not in lit and "EoM r" not in lit

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from lecture_keys import reveal_all
 
 pytestmark = pytest.mark.browser
 
@@ -81,7 +82,7 @@ def test_a_rolling_disks_energy_bars_share_one_readable_scale(server, page):
     # the labels say the datum moved, and to where: V = m g y of the centre, y = R cos α − x sin α
     v_min = m * G * (R * math.cos(alpha)) - drop
     assert "V′" in p.inner_text("#instruments .energy-bars")
-    assert f"V_min = {v_min:.4g} J" in p.inner_text("#instruments .energy-bars")
+    assert f"min V = {v_min:.4g} J" in p.inner_text("#instruments .energy-bars")
     assert page.errors == []
 
 
@@ -163,7 +164,7 @@ def visible_labels(p, step: str) -> list[str]:
     return p.eval_on_selector_all(
         f".step[data-step='{step}'] .math-line",
         """ls => ls.filter(l => l.getClientRects().length > 0)
-             .map(l => l.querySelector('.line-label')?.textContent.trim())""",
+             .map(l => l.dataset.label)""",
     )
 
 
@@ -263,9 +264,7 @@ def test_lecture_modes_provenance_words_wrap_in_the_column(server, page, sized, 
     sized(width, height)
     p.goto(f"{server}/scenes/double_pendulum?lecture=1")
     p.wait_for_function("() => document.getElementById('steps').dataset.typeset === '1'")
-    n = p.locator("#steps > .step").count()
-    for _ in range(n):
-        p.keyboard.press("ArrowRight")
+    reveal_all(p)
     p.wait_for_selector(".pv-panel")
     p.eval_on_selector_all(".pv-panel", "ds => ds.forEach((d) => { d.open = true; })")
     p.wait_for_function("() => document.querySelectorAll('.pv-table .pv-origin').length > 0")
