@@ -343,6 +343,11 @@ class CheckResponse(BaseModel):
     """The verdict and feedback that points at the error."""
 
     correct: bool
+    confirmed: bool = Field(
+        default=True,
+        description="False when the answer equals the derived result at every state sampled but "
+        "sympy could not prove it: `correct` is then false without the answer being shown wrong.",
+    )
     feedback: list[str] = Field(
         description="Sentences that point at the error; their math is inline LaTeX between "
         "dollar signs (`Sign error in the $\\frac{g}{l} \\sin\\theta$ term.`), never code."

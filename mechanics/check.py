@@ -52,6 +52,10 @@ MAX_SIGN_CASES = 3
 MAX_TRIG_MULTIPLE = 8
 
 
+#: How a verdict that no proof could settle begins (`Verdict.confirmed`).
+UNCONFIRMED = "Not confirmed"
+
+
 @dataclass
 class Verdict:
     correct: bool
@@ -59,9 +63,16 @@ class Verdict:
     answer_latex: str = ""
     expected_latex: str = ""
 
+    @property
+    def confirmed(self) -> bool:
+        """False when the samples agree but no proof could tell: neither right nor wrong is
+        claimed (the page says 'not confirmed', not 'not yet')."""
+        return not any(line.startswith(UNCONFIRMED) for line in self.feedback)
+
     def to_json(self, reveal: bool) -> dict[str, Any]:
         out = {
             "correct": self.correct,
+            "confirmed": self.confirmed,
             "feedback": self.feedback,
             "answer_latex": self.answer_latex,
         }
@@ -490,7 +501,7 @@ class _Judge:
             else "equals the derived result"
         )
         return (
-            f"Not confirmed: your answer {what} at every state sampled, but sympy could not "
+            f"{UNCONFIRMED}: your answer {what} at every state sampled, but sympy could not "
             f"show that {named} is {'a constant' if constant else 'zero'}. Samples can miss "
             "a term that is really there (a narrow bump, a tiny coefficient), so check it by "
             "hand, or write your answer more simply (expanded, with sin and cos, without abs, "

@@ -230,3 +230,34 @@ def test_a_multiple_angle_identity_in_two_coordinates_is_proved():
         " * (sin(3*theta1 - 5*theta2)**2 + cos(3*theta1 - 5*theta2)**2)**3"
     )
     assert verdict(answer, scene="double_pendulum").correct is True
+
+
+def test_an_unproved_agreement_is_neither_correct_nor_wrong_over_the_api():
+    """A narrow bump in θ̇ agrees with ½ m l² θ̇² at every sample; no proof shows the difference is
+    zero (it is not): the API says correct: false and confirmed: false, and a plain wrong answer
+    (a missing ½, shown wrong) is confirmed."""
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    with TestClient(app) as c:
+        bump = "m*l**2*theta_dot**2/2 + exp(-1000000*theta_dot**2)"
+        r = c.post(
+            "/api/v1/check", json={"scene_id": "simple_pendulum", "quantity": "T", "answer": bump}
+        )
+        assert r.status_code == 200
+        assert (r.json()["correct"], r.json()["confirmed"]) == (False, False)
+        wrong = c.post(
+            "/api/v1/check",
+            json={"scene_id": "simple_pendulum", "quantity": "T", "answer": "m*l**2*theta_dot**2"},
+        ).json()
+        assert (wrong["correct"], wrong["confirmed"]) == (False, True)
+        right = c.post(
+            "/api/v1/check",
+            json={
+                "scene_id": "simple_pendulum",
+                "quantity": "T",
+                "answer": "m*l**2*theta_dot**2/2",
+            },
+        ).json()
+        assert (right["correct"], right["confirmed"]) == (True, True)

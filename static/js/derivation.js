@@ -98,8 +98,10 @@ function yourTurn(stepId, target, coordinates) {
         const r = await postJSON("/api/v1/check", body);
         if (mine !== asked) return;
         box.querySelector(".echo").textContent = `read as \\(${r.answer_latex}\\)`;
-        verdict.textContent = r.correct ? "✔ Correct" : "✘ Not yet";
-        verdict.className = `verdict ${r.correct ? "ok" : "bad"}`;
+        // equal at every state sampled but not proved: neither right nor wrong is claimed
+        const open = !r.correct && r.confirmed === false;
+        verdict.textContent = r.correct ? "✔ Correct" : open ? "? Not confirmed" : "✘ Not yet";
+        verdict.className = `verdict ${r.correct ? "ok" : open ? "open" : "bad"}`;
         // each feedback sentence carries its math as $…$ (LaTeX), rendered by MathJax
         box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: inlineMath(f) })));
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
