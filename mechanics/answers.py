@@ -43,7 +43,9 @@ def _normalise(text: str) -> tuple[str, list[int]]:
     out: list[str] = []
     origin: list[int] = []
     for i, ch in enumerate(text):
-        piece = f" {GREEK[ch]}" if ch in GREEK else SYMBOLS.get(ch, ch)
+        # a lone d before a Greek letter is a differential (dθ/dt): dtheta, not d*theta
+        differential = i and text[i - 1] == "d" and (i < 2 or not text[i - 2].isalnum())
+        piece = (("" if differential else " ") + GREEK[ch]) if ch in GREEK else SYMBOLS.get(ch, ch)
         out.append(piece)
         origin += [i] * len(piece)
     return "".join(out), origin
@@ -126,6 +128,9 @@ def to_convention_mapped(
             continue
         if kind == "op" and value == "^":
             value = "**"
+        if kind == "name" and value == "dt" and "dt" not in known and _leibniz(out, typed):
+            out.pop()  # dtheta/dt: the '/' goes, dtheta already reads theta_dot
+            continue
         if kind == "name":
             try:
                 pieces = _resolve(value, coordinates, known, vocabulary)
@@ -145,6 +150,15 @@ def to_convention_mapped(
         where += [at] * len(value)
     where.append(len(typed))
     return "".join(result), where
+
+
+def _leibniz(out: list[tuple[str, str, int]], typed: str) -> bool:
+    """Is the text so far `d<q> /`, a derivative dq/dt in Leibniz's notation (what a student
+    types for q̇: `1/2 m l^2 (dtheta/dt)^2`)?"""
+    if len(out) < 2 or out[-1][:2] != ("op", "/"):
+        return False
+    kind, name, at = out[-2]
+    return kind == "name" and name.endswith("_dot") and typed[at : at + 1] == "d"
 
 
 def _resolve(name: str, coordinates: set[str], known: set[str], vocabulary: set[str]) -> list[str]:

@@ -261,3 +261,21 @@ def test_an_unproved_agreement_is_neither_correct_nor_wrong_over_the_api():
             },
         ).json()
         assert (right["correct"], right["confirmed"]) == (True, True)
+
+
+@pytest.mark.parametrize(
+    "answer", ["1/2 m l^2 (dtheta/dt)^2", "m l^2/2 * dtheta/dt * dtheta/dt", "(1/2) m (l dθ/dt)^2"]
+)
+def test_leibniz_notation_reads_as_a_velocity(answer):
+    """dθ/dt is how many students type θ̇ (student play-test: it was 'unknown name dt; did you
+    mean t?'). T = ½ m l² θ̇² by hand."""
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    with TestClient(app) as c:
+        r = c.post(
+            "/api/v1/check", json={"scene_id": "simple_pendulum", "quantity": "T", "answer": answer}
+        )
+    assert r.status_code == 200, r.text
+    assert r.json()["correct"] is True, r.json()

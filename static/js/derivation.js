@@ -97,13 +97,15 @@ function yourTurn(stepId, target, coordinates) {
       try {
         const r = await postJSON("/api/v1/check", body);
         if (mine !== asked) return;
-        box.querySelector(".echo").textContent = `read as \\(${r.answer_latex}\\)`;
+        box.querySelector(".echo").textContent = `read as \\(\\displaystyle ${r.answer_latex}\\)`;
         // equal at every state sampled but not proved: neither right nor wrong is claimed
         const open = !r.correct && r.confirmed === false;
         verdict.textContent = r.correct ? "✔ Correct" : open ? "? Not confirmed" : "✘ Not yet";
         verdict.className = `verdict ${r.correct ? "ok" : open ? "open" : "bad"}`;
         // each feedback sentence carries its math as $…$ (LaTeX), rendered by MathJax
-        box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: inlineMath(f) })));
+        // in display size: a fraction in a sentence is otherwise 8 px high (student play-test)
+        const shown = (f) => inlineMath(f).replace(/\\\(/g, "\\(\\displaystyle ");
+        box.querySelector(".feedback").replaceChildren(...r.feedback.map((f) => el("li", { textContent: shown(f) })));
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
         offerPrediction(box.querySelector(".predict"), r.correct ? null : body);
         await typeset([result]);

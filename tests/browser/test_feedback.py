@@ -43,6 +43,16 @@ def test_your_turn_feedback_is_math_replaced_and_announced(server, page):
     assert "Sign error" in shown
     assert not any(code in shown for code in CODE), shown
     first = items.count()
+    # its g/l is a fraction at display size, as tall as two lines of the sentence's text
+    # (inline, a fraction in a sentence shrinks to ~8 px per line: unreadable on a projector)
+    ratio = p.evaluate(
+        """(box) => Math.max(...[...box.querySelectorAll('.feedback mjx-container')]
+              .filter((m) => m.querySelector('[data-mml-node="mfrac"]'))
+              .map((m) => m.querySelector('svg').getBoundingClientRect().height
+                          / parseFloat(getComputedStyle(m.closest('li')).fontSize)))""",
+        box.element_handle(),
+    )
+    assert ratio >= 1.8, ratio
 
     # another wrong answer replaces the list (never stacked under the first)
     check_answer(p, box, "m l^2 theta'' = m g l sin(theta) + m theta'")
