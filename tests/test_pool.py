@@ -325,10 +325,10 @@ def test_a_check_on_a_built_in_scene_has_its_own_short_budget_and_names_the_answ
     monkeypatch.setenv("LAGRANGE_LAB_CHECK_SECONDS", "1")
     honest = {"scene_id": "simple_pendulum", "quantity": "T", "answer": "1/2 m l^2 theta'^2"}
     assert client.post("/api/v1/check", json=honest).status_code == 200
-    # right, but sympy grinds on showing (sin² + cos²)³² = 1 for seconds (exp(exp(exp(…))),
-    # once used here, is refused by the parser now)
-    slow = "(sin(theta)**2+cos(theta)**2)**32*(sin(theta_dot)**2+cos(theta_dot)**2)**32"
-    hostile = {**honest, "answer": f"1/2 m l^2 theta'^2 * {slow} * (sin(m)**2+cos(m)**2)**32"}
+    # wrong, and sympy grinds for seconds over its 29 unit-mixing terms ((sin² + cos²)³², once
+    # used here, is now proved 1 in milliseconds; exp(exp(exp(…))) is refused by the parser)
+    slow = "+".join(f"sin({k}*theta)**2*cos({k}*theta_dot)" for k in range(1, 30))
+    hostile = {**honest, "answer": f"1/2 m l^2 theta'^2 + {slow}"}
     start = time.monotonic()
     response = client.post("/api/v1/check", json=hostile)
     elapsed = time.monotonic() - start
