@@ -182,7 +182,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 verdict = _stability(variant, q0, free, values, root.family_dim)
         except (_BeyondDoubles, np.linalg.LinAlgError, OverflowError) as exc:
             raise _beyond_doubles(d, parameters or {}, q0, exc) from None
-        except ValueError:  # sympy cannot differentiate the forces here: sign(q̇) at q̇ = 0
+        except ValueError as exc:  # sympy cannot differentiate the forces: sign(q̇) at q̇ = 0
+            if not _dry_friction(d):  # no friction to blame (g = 1e308 overflows): say so
+                raise _beyond_doubles(d, parameters or {}, q0, exc) from None
             verdict = Verdict("marginal", _NOT_SMOOTH, [], [], [], [], None)
             if _NOT_SMOOTH_WARNING not in warnings:
                 warnings.append(_NOT_SMOOTH_WARNING)

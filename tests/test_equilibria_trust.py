@@ -204,3 +204,25 @@ def test_elastic_pendulum_eigenvalues_pair_with_the_frequencies_in_order():
     assert listed[1::2] == pytest.approx([-w for w in expected], rel=1e-9)  # ... each with −iω
     text = e["reason"]
     assert text.index(f"±{expected[0]:.4g}i") < text.index(f"±{expected[1]:.4g}i")
+
+
+def test_an_overflowing_gravity_is_not_blamed_on_coulomb_friction():
+    """g = 1e308 on a frictionless pendulum: the linearization overflows, and the 422 says so on
+    parameters.g; 'not differentiable (Coulomb friction)' stays for the scene that has it."""
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    with TestClient(app) as c:
+        r = c.post(
+            "/api/v1/equilibria", json={"scene_id": "simple_pendulum", "parameters": {"g": 1e308}}
+        )
+        assert r.status_code == 422, r.text
+        [error] = r.json()["detail"]
+        assert error["field"] == "parameters.g" and "overflows" in error["message"]
+        assert "friction" not in error["message"].lower()
+        r = c.post(
+            "/api/v1/equilibria",
+            json={"scene_id": "incline_friction", "parameters": {"alpha": 0.0}},
+        )
+        assert r.status_code == 200 and {e["kind"] for e in r.json()["equilibria"]} == {"marginal"}
