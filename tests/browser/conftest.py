@@ -91,6 +91,16 @@ class Watched:
             return
         self.errors.append(f"request failed: {request.url} ({request.failure})")
 
+    def open_paused(self, url: str) -> None:
+        """Open a scene page, wait for its server run, and pause the animation on it."""
+        p = self.page
+        p.goto(url)
+        p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
+        self.settle()
+        if p.get_attribute("#play", "aria-pressed") != "false":
+            p.click("#play")
+        p.wait_for_timeout(150)
+
     def settle(self, timeout: float = 60_000) -> None:
         """Wait until no API request is in flight (before leaving or reloading the page)."""
         self.page.wait_for_function(

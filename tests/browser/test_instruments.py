@@ -21,16 +21,6 @@ def exact_period(g: float) -> float:
     return 4 * math.sqrt(L / g) * float(ellipk(math.sin(THETA0 / 2) ** 2))
 
 
-def open_paused(page, url: str) -> None:
-    p = page.page
-    p.goto(url)
-    p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
-    page.settle()
-    if p.get_attribute("#play", "aria-pressed") != "false":
-        p.click("#play")
-    p.wait_for_timeout(150)
-
-
 def at(p) -> tuple[int, float]:
     """The sample on screen and its time, as the instruments show it."""
     frame = int(p.get_attribute("#instruments", "data-frame"))
@@ -53,7 +43,7 @@ def seek(p, permille: int) -> None:
 
 def test_energy_bars_follow_the_motion_and_e_stays_put(server, page):
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum?t_end=10")
+    page.open_paused(f"{server}/scenes/simple_pendulum?t_end=10")
     seek(p, 0)
     first = bars(p)
     assert set(first) == {"T", "V", "E"}  # no work from outside: no W bars
@@ -77,7 +67,7 @@ def test_energy_bars_follow_the_motion_and_e_stays_put(server, page):
 
 def test_single_steps_move_one_sample_with_buttons_and_keys(server, page):
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum?t_end=10")
+    page.open_paused(f"{server}/scenes/simple_pendulum?t_end=10")
     seek(p, 300)
     f0, t0 = at(p)
     p.keyboard.press(".")
@@ -100,7 +90,7 @@ def test_single_steps_move_one_sample_with_buttons_and_keys(server, page):
 
 def test_the_stopwatch_reads_the_simulation_clock(server, page):
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum?t_end=10")
+    page.open_paused(f"{server}/scenes/simple_pendulum?t_end=10")
     seek(p, 0)
     p.select_option("#speed", "0.5")  # half speed: simulated seconds pass at half the wall's rate
     p.click("#play")
@@ -123,7 +113,7 @@ def test_the_stopwatch_reads_the_simulation_clock(server, page):
 
 def test_period_timer_and_a_gravity_preset(server, page):
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum?t_end=20")
+    page.open_paused(f"{server}/scenes/simple_pendulum?t_end=20")
     seek(p, 1000)
     earth = float(p.get_attribute("#period", "data-period"))
     assert earth == pytest.approx(exact_period(9.81), rel=2e-3)

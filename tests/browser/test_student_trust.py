@@ -16,16 +16,6 @@ pytestmark = pytest.mark.browser
 G = 9.81
 
 
-def open_paused(page, url: str) -> None:
-    p = page.page
-    p.goto(url)
-    p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
-    page.settle()
-    if p.get_attribute("#play", "aria-pressed") != "false":
-        p.click("#play")
-    p.wait_for_timeout(150)
-
-
 def seek(p, permille: int) -> None:
     p.eval_on_selector(
         "#scrub", "(s, v) => { s.value = v; s.dispatchEvent(new Event('input')); }", permille
@@ -59,7 +49,7 @@ def test_a_rolling_disks_energy_bars_share_one_readable_scale(server, page):
     T = 737 J and V = −735 J, too short to see)."""
     p = page.page
     m, R, alpha, t_end = 1.0, 0.3, 0.5, 10.0
-    open_paused(page, f"{server}/scenes/rolling_disk?t_end={t_end:g}")
+    page.open_paused(f"{server}/scenes/rolling_disk?t_end={t_end:g}")
     x1 = G * math.sin(alpha) * t_end**2 / 3
     drop = m * G * math.sin(alpha) * x1
     seek(p, 0)
@@ -91,7 +81,7 @@ def test_no_period_where_nothing_swings(server, page, scene):
     """Both start from rest and accelerate uniformly (an Atwood machine's heavier side falls, a
     disk rolls down): the coordinate only grows, so no sample of the run may show a period."""
     p = page.page
-    open_paused(page, f"{server}/scenes/{scene}")
+    page.open_paused(f"{server}/scenes/{scene}")
     for permille in (0, 500, 1000):
         seek(p, permille)
         assert p.get_attribute("#period", "data-period") is None
@@ -105,7 +95,7 @@ def test_swings_times_only_a_steady_swing(server, page):
     a ramp and a parabola never swing back; sin(t²) swings faster and faster (no single period);
     a swing too slow for the run (period 40 s over 10 s) turns back but is not timed."""
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum")
+    page.open_paused(f"{server}/scenes/simple_pendulum")
     got = p.evaluate(
         """async () => {
           const { swings } = await import('/static/js/instruments.js');
@@ -137,7 +127,7 @@ def test_a_refused_run_greys_the_last_runs_numbers_with_the_reason(server, page)
     statistics, instruments, plots and work table still hold the last run's numbers; each is
     greyed and says why, until a run of values the server accepts comes in."""
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum")
+    page.open_paused(f"{server}/scenes/simple_pendulum")
     parts = ["#stats", "#instruments", ".plots .plot-grid", "#work-panel .work-grid"]
     stale = "sels => sels.map(s => document.querySelector(s).classList.contains('stale'))"
     assert p.evaluate(stale, parts) == [False] * 4
@@ -177,7 +167,7 @@ def test_your_turn_hides_its_answer_until_it_is_earned(server, page):
     and θ̈ = −(g/l) sin θ. Opening "Your turn: T" hides T (and the bob's own T, the same
     expression); V stays. A correct V checked brings V's lines back; "Show answer" brings T's."""
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum")
+    page.open_paused(f"{server}/scenes/simple_pendulum")
     p.wait_for_selector(".step[data-step='energy'] .line-label")
     assert visible_labels(p, "energy") == ["T_bob", "V_bob", "T", "V"]
     your_turn(p, "energy", 0).locator("summary").click()
@@ -213,7 +203,7 @@ def test_the_answer_labels_of_each_kind_of_box(server, page):
     """answerLabels against a cart-pendulum's labels (x, θ): the second equation of motion is θ's
     with the three lines that work it out; Q and q̈ by the coordinate's place."""
     p = page.page
-    open_paused(page, f"{server}/scenes/simple_pendulum")
+    page.open_paused(f"{server}/scenes/simple_pendulum")
     got = p.evaluate(
         """async () => {
           const { answerLabels } = await import('/static/js/page.js');
