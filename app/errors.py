@@ -44,7 +44,7 @@ def error_body(field: str, message: str) -> dict[str, list[dict[str, str]]]:
 
 def unprocessable(errors: Iterable[dict[str, str]]) -> JSONResponse:
     """A 422 listing every problem as {field, message}."""
-    detail = [{"field": e["field"], "message": _readable(e["message"])} for e in errors]
+    detail = [{"field": e["field"], "message": readable(e["message"])} for e in errors]
     return JSONResponse({"detail": detail}, status_code=422)
 
 
@@ -220,7 +220,7 @@ def _one_message(messages: list[str]) -> str:
 _CLASS_NAME = re.compile(r" or instance of \w+")
 
 
-def _readable(message: str) -> str:
+def readable(message: str) -> str:
     # pydantic prefixes a validator's own words with "Value error, "; the field already says where.
     message = _CLASS_NAME.sub("", message.removeprefix("Value error, "))
     return message.replace("a valid dictionary or object to extract fields from", "a JSON object")

@@ -26,6 +26,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationErr
 from starlette.concurrency import run_in_threadpool
 
 from app import derivations
+from app.errors import readable
 from app.routes.scenes import unknown_scene
 from app.routes.simulate import simulation_answer
 from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
@@ -505,7 +506,7 @@ async def _decoded(token: str, http: Request) -> ShareState:
     except ShareError as exc:
         raise HTTPException(422, [{"field": "token", "message": str(exc)}]) from None
     except ValidationError as exc:
-        problems = [{"field": _token_field(e), "message": _plain(e["msg"])} for e in exc.errors()]
+        problems = [{"field": _token_field(e), "message": readable(e["msg"])} for e in exc.errors()]
         raise HTTPException(422, problems) from None
     # a hand-made token may name a scene or values the scene does not have: said here, not by
     # the page it would open
@@ -546,15 +547,6 @@ async def _runnable(
         raise HTTPException(
             422, [{"field": prefix + p["field"], "message": p["message"]} for p in problems]
         )
-
-
-#: pydantic names the model class a value should have been ("a valid dictionary or instance of
-#: SceneSpec"): a Python class name means nothing to whoever made the link.
-_CLASS_NAME = re.compile(r" or instance of \w+")
-
-
-def _plain(message: str) -> str:
-    return _CLASS_NAME.sub("", message).removeprefix("Value error, ")
 
 
 def _token_field(error: Any) -> str:
