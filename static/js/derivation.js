@@ -67,7 +67,7 @@ function copyButton(what, text) {
 }
 
 function yourTurn(stepId, target, coordinates) {
-  // prompts as math (MathJax typesets them with their step): Q_θ, θ̈₁, not Q_theta, theta1_ddot
+  // prompts as math: Q_θ, θ̈₁, not Q_theta, theta1_ddot
   const asks = {
     energy: [["T", null, `${inline("T")} =`], ["V", null, `${inline("V")} =`]],
     forces: coordinates.map((q) => ["Q", q, `${inline(`Q_{${nameTex(q)}}`)} =`]),
@@ -85,7 +85,19 @@ function yourTurn(stepId, target, coordinates) {
       <p class="verdict"></p><ul class="feedback"></ul><div class="expected"></div></div>
       <div class="predict"></div>`;
     box.querySelector("summary").textContent = `Your turn: ${prompt.replace(/\s*[:=]$/, "")}`;
-    box.querySelector(".prompt").textContent = prompt;
+    // The prompt inside the box is typeset when the box is first opened, not with its step:
+    // nobody sees it before, and the double pendulum has nine (issue 13: every step typeset
+    // within 1.0 s). Until then MathJax skips it (its ignore class) and its source is out of sight.
+    const promptEl = box.querySelector(".prompt");
+    promptEl.textContent = prompt;
+    promptEl.classList.add("mathjax_ignore");
+    promptEl.style.visibility = "hidden";
+    box.addEventListener("toggle", async () => {
+      if (!box.open || !promptEl.classList.contains("mathjax_ignore")) return;
+      promptEl.classList.remove("mathjax_ignore");
+      await typeset([promptEl]);
+      promptEl.style.visibility = "";
+    });
     const input = box.querySelector("input");
     const result = box.querySelector(".result");
     const verdict = box.querySelector(".verdict");

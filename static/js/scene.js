@@ -510,15 +510,22 @@ class SceneView {
       if (items.some((item) => view.has(item))) releaseMathJax();
       else await this.motion;
       const left = new Set(items);
+      const pace = typesetPace();
       while (left.size) {
-        // the steps in view first (again after each step: the reader may have scrolled), then
+        // the steps in view first (again after each batch: the reader may have scrolled), then
         // the rest in order; a hidden step (lecture mode) is typeset too, ready when revealed
-        const item = items.find((i) => left.has(i) && view.has(i)) || items.find((i) => left.has(i));
-        left.delete(item);
-        await typeset([item]);
-        raw(item, false);
-        item.dataset.typeset = "1";
-        // a task of its own per step: a frame due meanwhile is drawn between two steps
+        const order = [...items.filter((i) => left.has(i) && view.has(i)),
+          ...items.filter((i) => left.has(i) && !view.has(i))];
+        const batch = pace.take(order);
+        batch.forEach((item) => left.delete(item));
+        const started = performance.now();
+        await typeset(batch);
+        pace.learn(batch, performance.now() - started);
+        batch.forEach((item) => {
+          raw(item, false);
+          item.dataset.typeset = "1";
+        });
+        // a task of its own per batch: a frame due meanwhile is drawn between two batches
         await new Promise((resolve) => setTimeout(resolve, 0));
       }
     } finally {
@@ -602,6 +609,34 @@ function inlineData() {
     spec: spec && Promise.resolve(spec),
     live: live || null,
     derivation: derivation && Promise.resolve(derivation),
+  };
+}
+
+/** How many steps to typeset in one go. Each MathJax call measures the page's layout once, so
+ * one call per step costs the double pendulum a third more than a few calls in all; but one call
+ * for everything holds the main thread (and the animation) for a quarter of a second. So steps
+ * are grouped to about BATCH_MS of work each, at the pace this machine was seen to typeset. */
+const BATCH_MS = 50;
+
+function typesetPace() {
+  const size = (item) => item.textContent.length || 1; // the LaTeX source: a proxy for the work
+  let msPerChar = null; // unknown until the first step was typeset
+  return {
+    take(order) {
+      if (msPerChar === null) return order.slice(0, 1);
+      const batch = [];
+      let cost = 0;
+      for (const item of order) {
+        cost += size(item) * msPerChar;
+        if (batch.length && cost > BATCH_MS) break;
+        batch.push(item);
+      }
+      return batch;
+    },
+    learn(batch, ms) {
+      const rate = ms / batch.reduce((n, item) => n + size(item), 0);
+      msPerChar = msPerChar === null ? rate : (msPerChar + rate) / 2;
+    },
   };
 }
 

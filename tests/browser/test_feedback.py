@@ -78,6 +78,32 @@ def test_your_turn_feedback_is_math_replaced_and_announced(server, page):
     assert [e for e in page.errors if "422" not in e] == []
 
 
+def test_a_closed_boxs_prompt_is_typeset_when_opened_and_never_shown_as_source(server, page):
+    """The prompts inside closed Your-turn boxes wait for their box (issue 13: the double
+    pendulum's nine are work nobody sees with the step); opened, the prompt is math."""
+    p = page.page
+    p.goto(f"{server}/scenes/double_pendulum")
+    wait_ready(page)
+    boxes = p.locator("details.yourturn")
+    assert boxes.count() == 9
+    closed = p.evaluate(
+        """() => [...document.querySelectorAll('details.yourturn .prompt')].map((el) =>
+             [el.querySelectorAll('mjx-container').length, el.style.visibility])"""
+    )
+    assert closed == [[0, "hidden"]] * 9  # untouched, and its LaTeX source out of sight
+    # the summary is seen with the step, so it is math already
+    assert boxes.nth(0).locator("summary mjx-container").count() == 1
+    box = boxes.nth(5)  # the equation of motion for theta1
+    box.locator("summary").click()
+    prompt = box.locator(".prompt")
+    p.wait_for_function(
+        "(el) => el.querySelector('mjx-container') && el.style.visibility === ''",
+        arg=prompt.element_handle(),
+    )
+    assert "\\(" not in prompt.inner_text()
+    assert "equation of motion for" in prompt.inner_text()
+
+
 def test_equilibria_closed_forms_are_math(server, page):
     p = page.page
     p.goto(f"{server}/scenes/bead_on_hoop?Omega=6")
