@@ -30,9 +30,12 @@ export function sceneShapes(geom, view, i, opts = {}) {
   }
   for (const w of geom.wires) wire(geom, view, w, i, out);
   for (const c of geom.cones) cone(geom, view, c, i, out);
+  const occupied = []; // screen boxes a label must not cover: pulleys, bodies, labels placed
   for (const [p, r] of geom.pulleys) {
     const [cx, cy] = P(p);
-    out.push({ t: "circle", c: [cx, cy], r: r * view.scale, color: INK, width: 2, fill: "#f1f3f5" });
+    const R = r * view.scale;
+    out.push({ t: "circle", c: [cx, cy], r: R, color: INK, width: 2, fill: "#f1f3f5" });
+    occupied.push([cx - R, cy - R, cx + R, cy + R]);
     out.push({ t: "circle", c: [cx, cy], r: 3, fill: INK });
   }
   for (const r of geom.ropes) {
@@ -80,7 +83,6 @@ export function sceneShapes(geom, view, i, opts = {}) {
     out.push({ t: "circle", c: [x, y], r: 6, fill: "#f59f00", color: "#b36b00", width: 1.5 });
     out.push({ t: "text", at: [x + 9, y - 8], text: name, color: "#6c5200", size: o.font, halo: true });
   }
-  const occupied = [];
   for (const b of geom.bodies) body(geom, view, b, i, tint(b.name), rad(b.name), sliding.get(b.name), o, out, occupied);
   if (o.labels) {
     const w = view.w, h = view.h;
