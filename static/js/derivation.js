@@ -70,7 +70,9 @@ function yourTurn(stepId, target, coordinates) {
   // prompts as math: Q_θ, θ̈₁, not Q_theta, theta1_ddot
   const asks = {
     energy: [["T", null, `${inline("T")} =`], ["V", null, `${inline("V")} =`]],
-    forces: coordinates.map((q) => ["Q", q, `${inline(`Q_{${nameTex(q)}}`)} =`]),
+    // Q_j^{NC}, as the forces step writes it: only the non-conservative part is asked (gravity
+    // and springs are in V); "Q_x" led students following the notes' eq. 31 to add the weight
+    forces: coordinates.map((q) => ["Q", q, `${inline(`Q_{${nameTex(q)}}^{NC}`)} =`]),
     lagrange: [["L", null, `${inline("L")} =`],
       ...coordinates.map((q) => ["eom", q, `equation of motion for ${inline(nameTex(q))}:`])],
     matrix: coordinates.length <= 3 ? coordinates.map((q) => ["accel", q, `${inline(dottedTex(q, 2))} =`]) : [],
@@ -103,12 +105,39 @@ function yourTurn(stepId, target, coordinates) {
     const verdict = box.querySelector(".verdict");
     let asked = 0; // only the latest check may fill the box: a slow earlier answer never lands on it
     const ask = async (reveal) => {
+      // an empty box is no answer: never sent as "0" (which is Q^NC of every conservative scene,
+      // so doing nothing was "✔ Correct"); a 0 typed on purpose is checked like any answer
+      if (!reveal && !input.value.trim()) {
+        ++asked; // a check still on its way must not land on the box after this
+        for (const part of [".echo", ".expected"]) box.querySelector(part).textContent = "";
+        box.querySelector(".feedback").replaceChildren();
+        offerPrediction(box.querySelector(".predict"), null);
+        verdict.className = "verdict empty";
+        verdict.textContent = "Type an answer first.";
+        result.dataset.checked = String(asked);
+        input.focus();
+        return;
+      }
       const mine = ++asked;
-      const body = { ...target(), quantity, answer: input.value || "0", reveal };
+      // "Show answer" on an empty box: the API wants an answer, so a 0 is sent, but no verdict
+      // on that 0 is shown (it was "✔ Correct" where the answer is 0), only the derived answer
+      const unanswered = !input.value.trim();
+      const body = { ...target(), quantity, answer: unanswered ? "0" : input.value, reveal };
       if (coordinate) body.coordinate = coordinate;
       try {
         const r = await postJSON("/api/v1/check", body);
         if (mine !== asked) return;
+        if (unanswered) {
+          box.querySelector(".echo").textContent = "";
+          verdict.textContent = "The derived answer:";
+          verdict.className = "verdict";
+          box.querySelector(".feedback").replaceChildren();
+          box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
+          offerPrediction(box.querySelector(".predict"), null);
+          await typeset([result]);
+          result.dataset.checked = String(mine);
+          return;
+        }
         box.querySelector(".echo").textContent = `read as \\(\\displaystyle ${r.answer_latex}\\)`;
         // equal at every state sampled but not proved: neither right nor wrong is claimed
         const open = !r.correct && r.confirmed === false;

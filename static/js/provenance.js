@@ -22,7 +22,7 @@ function pieceTex(piece, q) {
     case "d/dt ∂T/∂q̇": return `\\frac{d}{dt}\\frac{\\partial T}{\\partial ${dottedTex(q, 1)}}`;
     case "−∂T/∂q": return `-\\frac{\\partial T}{\\partial ${nameTex(q)}}`;
     case "∂V/∂q": return `+\\frac{\\partial V}{\\partial ${nameTex(q)}}`;
-    case "Q": return `Q_{${nameTex(q)}}`;
+    case "Q": return `Q_{${nameTex(q)}}^{NC}`;
     default: return "";
   }
 }
@@ -276,14 +276,15 @@ export async function traceTerms(container, provenance) {
   place("energy", "T", math("T"), [table(provenance.T, origins, null, "")]);
   place("energy", "V", math("V"), [table(provenance.V, origins, null, "")]);
   for (const [q, eq] of Object.entries(provenance.Q || {})) {
-    place("forces", `Q_${q}`, math(`Q_{${nameTex(q)}}`), [table(eq, origins, q, "")]);
+    // Q_j^{NC} as the forces step writes it: the weight and the springs are in V, not here
+    place("forces", `Q_${q}`, math(`Q_{${nameTex(q)}}^{NC}`), [table(eq, origins, q, "")]);
   }
   for (const [q, eom] of Object.entries(provenance.eom || {})) {
     const d = dottedTex(q, 1);
     const n = nameTex(q);
     place("lagrange", `EoM ${q}`, `the equation of motion for ${math(n)}`, [
       table(eom.lhs, origins, q, `left side ${math(`\\frac{d}{dt}\\frac{\\partial L}{\\partial ${d}} - \\frac{\\partial L}{\\partial ${n}}`)}`),
-      table(eom.rhs, origins, q, `right side ${math(`Q_{${n}}`)} (non-conservative forces)`),
+      table(eom.rhs, origins, q, `right side ${math(`Q_{${n}}^{NC}`)} (non-conservative forces)`),
     ]);
   }
   if (provenance.matrix) {
