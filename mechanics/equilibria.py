@@ -35,7 +35,7 @@ from sympy.physics.vector import Vector
 
 from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
-from mechanics.expr import to_latex, to_plain
+from mechanics.expr import parse, to_latex, to_plain
 from mechanics.model import T as t
 from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
@@ -179,7 +179,8 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         try:
             with np.errstate(all="ignore"):
-                verdict = _stability(variant, q0, free, values, root.family_dim)
+                power = _power_at(d, values, q0)
+                verdict = _stability(variant, q0, free, values, root.family_dim, power)
         except (_BeyondDoubles, np.linalg.LinAlgError, OverflowError) as exc:
             raise _beyond_doubles(d, parameters or {}, q0, exc) from None
         except ValueError as exc:  # sympy cannot differentiate the forces: sign(q̇) at q̇ = 0
@@ -1168,10 +1169,131 @@ def _starts(system: _System) -> np.ndarray:
     return np.array(grid, dtype=float)
 
 
+# --- the work of the non-conservative forces --------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Power:
+    """What the velocity-dependent non-conservative forces do to the energy near an equilibrium.
+
+    Lagrange–Dirichlet (a minimum of V is stable) rests on E = T + V never growing: it holds when
+    their power P = Σ_j Q_j q̇_j is 0 (gyroscopic: a magnetic force) or ≤ 0 (dissipative: a
+    damper), not when P has no sign (c ẋ³ pumps energy in at c ẋ⁴, while the linearization
+    sees nothing and calls it a minimum). ``kind``: "none", "no work", "dissipative" or
+    "no sign"; ``text``: P as derived, for the sentence."""
+
+    kind: str = "none"
+    text: str = ""
+
+
+def _force_power(d: Derivation) -> tuple[sp.Expr, list[sp.Expr], bool]:
+    """Once per scene: the velocity-dependent part of the forces' (and torques') power,
+    Σ_j (Q_j − Q_j|q̇=0) q̇_j (the part at rest is conservative, in K, or circulatory, seen by
+    K's asymmetry); each damper's coefficient c (its power is −c ℓ̇² ≤ 0 while c ≥ 0, a
+    dashpot); and whether any force depends on a velocity at all."""
+    m = d.model
+    turning = _turning(m)  # then Σ Q q̇ ≠ F·v: dampers are judged like any force
+    rest = dict.fromkeys(m.qd, sp.S.Zero)
+    dampers = [] if turning else [parse(x.c, m.names, field="c") for x in m.spec.dampers]
+    power, moves = sp.S.Zero, False
+    for load in m.loads:
+        if load.kind == "damper" and not turning:
+            continue
+        if load.kind == "torque":
+            body = next(b for b in m.bodies if b.name == load.on)
+            w = body.frame.ang_vel_in(m.N)
+        else:
+            w = m.velocity(load.on)
+        for qd in m.qd:
+            Q = load.vector.dot(w.diff(qd, m.N))
+            moving = Q - Q.xreplace(rest)
+            if moving != 0:
+                moves = True
+                power += moving * qd
+    power = sp.expand(power)
+    if power != 0 and sp.count_ops(power) <= 400:
+        power = tidy(power, m)
+    return power, dampers, moves
+
+
+def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
+    """Power's kind at these parameter values, near q0: 0, provably ≤ 0 (every term a
+    non-negative number times an even power, or a quadratic part in q̇ that is negative
+    definite at q0, which wins near rest), or neither."""
+    m = d.model
+    if not m.loads:
+        return Power()
+    power, dampers, moves = _once(d, "power", "", lambda: _force_power(d))
+    try:
+        leaky = any(float(c.xreplace(values)) < 0 for c in dampers)
+    except (TypeError, ValueError):
+        leaky = True
+    text = to_plain(power)
+    if leaky:
+        return Power("no sign", "a damper with c < 0")
+    if not moves:
+        return Power("dissipative" if dampers else "none")
+    at = sp.expand(power.xreplace(values)) if power != 0 else power
+    if at == 0:  # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0
+        return Power("dissipative" if dampers else "no work")
+    if _never_positive(m, at) or _quadratic_wins(m, at, q0):
+        return Power("dissipative", text)
+    return Power("no sign", text)
+
+
+def _never_positive(m: Any, power: sp.Expr) -> bool:
+    """A proof that P ≤ 0 for every state, or False: P is −(a sum of non-negative terms),
+    as written or factored (−c (ẋ − ẏ)²), or a quadratic form q̇ᵀ D(q) q̇ whose D sympy shows
+    negative semidefinite for every q. Bounded: a large P is left unproven."""
+    real = {s: sp.Dummy(real=True) for s in (*m.q, *m.qd, m.names["t"])}
+    if sp.count_ops(power) > 400:
+        return False
+    p = power.xreplace(real)
+    try:
+        if (-p).is_nonnegative or (-sp.factor(p)).is_nonnegative:
+            return True
+        v = [real[qd] for qd in m.qd]
+        if not sp.Poly(p, *v).is_homogeneous or sp.Poly(p, *v).total_degree() != 2:
+            return False
+        D = sp.Matrix(len(v), len(v), lambda i, j: p.diff(v[i]).diff(v[j]) / 2)
+        return bool(D.is_negative_semidefinite)
+    except (TypeError, ValueError, RecursionError, sp.PolynomialError):
+        return False
+
+
+def _quadratic_wins(m: Any, power: sp.Expr, q0: list[float]) -> bool:
+    """Is P = q̇ᵀ D q̇ + O(|q̇|³) with D negative definite at q0? Then P < 0 near rest."""
+    rest = dict.fromkeys(m.qd, sp.S.Zero)
+    point = {q: sp.Float(x) for q, x in zip(m.q, q0, strict=True)}
+    point[m.names["t"]] = sp.S.Zero
+    if explicit_time(power, m):
+        return False
+    try:
+        D = np.array(
+            [
+                [float(power.diff(a).diff(b).xreplace(rest).xreplace(point)) / 2 for b in m.qd]
+                for a in m.qd
+            ]
+        )
+    except (TypeError, ValueError):
+        return False
+    scale = float(np.max(np.abs(D), initial=0.0))
+    return scale > 0 and bool(np.all(np.linalg.eigvalsh((D + D.T) / 2) < -1e-9 * scale))
+
+
 # --- stability from the full linearization ---------------------------------------------------
 
 
 _NOT_ELEMENTARY = (sp.sign, sp.Abs, sp.DiracDelta, sp.Heaviside, sp.Derivative, sp.Subs)
+
+
+#: The linearization depends on t (a damper whose c varies in time, c cos t ẋ): its eigenvalues at
+#: one instant say nothing of the motion (Floquet's theory would).
+_TIMED = "timed"
+_TIME_VARYING = (
+    "the linearization M δq̈ + C δq̇ + K δq = 0 depends on time here (a velocity-dependent force "
+    "that varies with t): eigenvalues at one instant do not decide, and the linear test cannot"
+)
 
 
 @functools.lru_cache(maxsize=256)
@@ -1187,6 +1309,8 @@ def _linearization(mass: tuple, forcing: tuple, qs: tuple, qds: tuple, qdds: tup
     xs = [sp.Dummy(f"q{j}") for j in range(len(qs))]
     to_x = dict(zip(qs, xs, strict=True))
     exprs = [[e.xreplace(to_x) for e in group] for group in (M, K, C)]
+    if any(e.has(t) for group in exprs for e in group):
+        return _TIMED
     return sp.lambdify([*xs, *psyms], exprs, modules="numpy", dummify=True)
 
 
@@ -1198,7 +1322,12 @@ def _derivative(expr: sp.Expr, var: sp.Expr) -> sp.Expr:
 
 
 def _stability(
-    v: Variant, q0: list[float], free: list[int], values: dict, family_dim: int = 0
+    v: Variant,
+    q0: list[float],
+    free: list[int],
+    values: dict,
+    family_dim: int = 0,
+    power: Power = Power(),
 ) -> Verdict:
     """M δq̈ + C δq̇ + K δq = 0 with K = −∂f/∂q, C = −∂f/∂q̇ at rest; the eigenvalues λ of the
     first-order system decide (δq ∝ e^{λt}), and why is put in words.
@@ -1206,7 +1335,9 @@ def _stability(
     Every coordinate takes part (a free cart still moves with its pendulum), except one whose
     mass-matrix row vanishes there: a coordinate singularity such as φ at the pole of a sphere.
     Zero eigenvalues are neutral along free (cyclic) coordinates and along the ``family_dim``
-    directions of a family of equilibria through q0, undecided otherwise.
+    directions of a family of equilibria through q0, undecided otherwise. ``power``: what the
+    velocity-dependent forces do to the energy, on which a verdict 'stable by the potential'
+    rests.
     """
     m = v.model
     n = len(m.q)
@@ -1214,6 +1345,8 @@ def _stability(
     at_rest = _linearization(
         tuple(v.mass_matrix), tuple(v.forcing), tuple(m.q), tuple(m.qd), tuple(m.qdd), psyms
     )
+    if at_rest is _TIMED:
+        return Verdict("marginal", _TIME_VARYING, [], [], [], [], None)
     if at_rest is not None:
         numbers = list(np.array([float(values[p]) for p in psyms], dtype=float))
         with np.errstate(all="ignore"):
@@ -1243,7 +1376,7 @@ def _stability(
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
     n_free = len([j for j in free if j in idx]) + family_dim
     names = [m.coordinate_names[j] for j in idx]
-    kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m))
+    kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m), power=power)
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
@@ -1351,7 +1484,7 @@ def _turning(m: Any) -> bool:
     )
 
 
-def _classify(M, C, K, n_free, names, *, turning: bool = False):
+def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = Power()):
     n = len(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam, vecs = np.linalg.eig(A)
@@ -1385,7 +1518,9 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
             f"an eigenvalue has positive real part (λ = {_z(grow)}): a small displacement "
             f"grows like e^({grow.real:.4g} t)"
         )
-        if np.min(k_eigs) < -k_tol and not gyroscopic:
+        if not symmetric:
+            reason += "; " + _circulatory(grow, tol)
+        elif np.min(k_eigs) < -k_tol and not gyroscopic:
             reason += (
                 f"; K has a negative eigenvalue: the {_potential(turning)} has no minimum here"
             )
@@ -1395,7 +1530,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         # what a nudge does without a restoring force depends on the velocity-linear terms
         if gyroscopic:
             nudge = (
-                "the Coriolis (gyroscopic) terms turn a nudge in velocity into a bounded loop, "
+                f"the {_gyroscopic(turning, power)} terms turn a nudge in velocity into a bounded "
+                "loop, "
                 "not a drift, but K is singular in every direction and nonlinear terms decide "
                 "(neutral at best)"
             )
@@ -1413,6 +1549,25 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
             "marginal",
             "every coordinate is free: no force acts at rest in any direction (K = 0), so every "
             f"nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
+            lam,
+            vecs,
+        )
+    if not symmetric:
+        # no potential stands behind K: only the eigenvalues of the full linearization speak
+        on_axis = lam[np.abs(lam.real) <= tol]
+        if not on_axis.size:
+            return (
+                "asymptotically stable",
+                f"every eigenvalue has negative real part ({shown}): every small motion dies "
+                f"out, {_CIRCULATORY}",
+                lam,
+                vecs,
+            )
+        return (
+            "marginal",
+            f"{_CIRCULATORY[0].upper()}{_CIRCULATORY[1:]}; no eigenvalue has positive real part, "
+            f"but some lie on the imaginary axis ({shown}): the linear test cannot decide "
+            "(nonlinear terms, or any damping, can tip circulatory forces into flutter)",
             lam,
             vecs,
         )
@@ -1440,6 +1595,18 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
             lam,
             vecs,
         )
+    if k_pd_off_free and c_psd and power.kind == "no sign":
+        return (
+            "marginal",
+            f"K is positive definite (the {_potential(turning)} has a minimum here) and no "
+            f"eigenvalue has positive real part ({shown}), but the velocity-dependent forces' "
+            f"power Σ Q_j q̇_j = {power.text} has no sign: they can feed energy in, which the "
+            "linearization does not see, so the minimum need not hold the motion "
+            "(Lagrange–Dirichlet needs forces that do no positive work) and the linear test "
+            f"cannot decide{free_note}",
+            lam,
+            vecs,
+        )
     if k_pd_off_free and c_psd:
         reason = f"K is positive definite, so the {_potential(turning)} has a minimum here"
         if n_free:  # K is singular along the free directions: definite only off them
@@ -1449,20 +1616,37 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
             )
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
             reason = (
-                "K is positive definite, so the potential (with the centrifugal term where a "
-                "frame turns) has a minimum; velocity-linear terms cannot undo that "
-                "(Thomson–Tait)"
+                f"K is positive definite, so the {_potential(turning)} has a minimum; "
+                "velocity-linear terms cannot undo that (Thomson–Tait)"
+            )
+        if power.kind == "no work":
+            reason += (
+                "; the velocity-dependent forces do no work (their power Σ Q_j q̇_j is 0), so "
+                "the energy cannot grow"
+            )
+        elif power.kind == "dissipative" and power.text:
+            reason += (
+                f"; the velocity-dependent forces' power Σ Q_j q̇_j = {power.text} is ≤ 0 "
+                "here: they only take energy out"
             )
         if damped:
             reason += ", and damping makes the motion decay"
         return "stable", reason + f" (eigenvalues {shown}){free_note}", lam, vecs
     on_axis = moving[np.abs(moving.real) <= tol]
     semisimple = _semisimple(A, on_axis, scale)
-    if symmetric and gyroscopic and not damped and semisimple and moving.size == on_axis.size:
+    if (
+        symmetric
+        and gyroscopic
+        and not damped
+        and semisimple
+        and moving.size == on_axis.size
+        and power.kind != "no sign"
+    ):
         return (
             "gyroscopically stable",
             f"K is not positive definite (its eigenvalues {', '.join(f'{k:.4g}' for k in k_shown)}"
-            "), but the gyroscopic (Coriolis) terms C keep every eigenvalue on the imaginary "
+            f"), but the {_gyroscopic(turning, power)} terms C keep every eigenvalue on the "
+            "imaginary "
             f"axis without repeated defective ones ({shown}): the linearized motion stays "
             "bounded. Any damping would destroy this (Kelvin–Tait–Chetaev), and nonlinear terms "
             "may too",
@@ -1471,8 +1655,11 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         )
     if not semisimple:
         why = "a repeated eigenvalue on the imaginary axis lacks a full set of eigenvectors"
-    elif not symmetric:
-        why = "K is not symmetric (forces at rest that are not from a potential)"
+    elif power.kind == "no sign":
+        why = (
+            f"the velocity-dependent forces' power Σ Q_j q̇_j = {power.text} has no sign (they "
+            "can feed energy in)"
+        )
     else:
         why = "K is not positive definite and no gyroscopic term accounts for the stability"
     return (
@@ -1482,6 +1669,36 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False):
         lam,
         vecs,
     )
+
+
+_CIRCULATORY = (
+    "K is not symmetric: position-dependent non-conservative (circulatory) forces act, a "
+    "follower load say, so no potential stands behind K and its eigenvalues say nothing of a "
+    "minimum; only the eigenvalues of the full linearization decide"
+)
+
+
+def _circulatory(grow: complex, tol: float) -> str:
+    """Why an equilibrium under circulatory forces is lost: flutter or divergence."""
+    if abs(grow.imag) > tol:
+        return (
+            f"{_CIRCULATORY}: flutter, a complex pair {_z(grow)} and its conjugate with positive "
+            "real part, an oscillation that grows"
+        )
+    return f"{_CIRCULATORY}: divergence, a real positive eigenvalue, a drift that grows"
+
+
+def _gyroscopic(turning: bool, power: Power) -> str:
+    """The velocity-linear terms by their source: Coriolis where a frame turns at a prescribed
+    rate (T has terms linear in q̇), forces that do no work (a magnetic one) otherwise."""
+    forces = power.kind == "no work"
+    if turning and forces:
+        return "gyroscopic (Coriolis, and forces that do no work)"
+    if turning:
+        return "gyroscopic (Coriolis)"
+    if forces:
+        return "gyroscopic (forces that do no work, like a magnetic one)"
+    return "gyroscopic"
 
 
 def _eigen_order(lam: np.ndarray) -> list[int]:
@@ -1619,12 +1836,16 @@ def _latex_text(s: str) -> str:
 def _stability_step(results: list[dict], verdicts: list[Verdict]) -> Step:
     text = (
         "About each equilibrium q₀ the motion linearizes to M δq̈ + C δq̇ + K δq = 0 with "
-        "K = −∂f/∂q and C = −∂f/∂q̇ at rest (C holds damping and the gyroscopic/Coriolis "
-        "terms of turning frames). With δq ∝ e^{λt} the eigenvalues λ of the first-order system "
-        "decide: any Re λ > 0 is unstable; all Re λ < 0 is asymptotically stable; K positive "
-        "definite is stable by the potential (Lagrange–Dirichlet), whatever C adds; K not "
-        "positive definite with every λ simple on the imaginary axis is gyroscopically stable "
-        "(only linearly: damping destroys it); what the linear test cannot decide is marginal. "
+        "K = −∂f/∂q and C = −∂f/∂q̇ at rest (C holds damping and the gyroscopic terms: "
+        "Coriolis where a frame turns, forces that do no work such as a magnetic one). With "
+        "δq ∝ e^{λt} the eigenvalues λ of the first-order system decide: any Re λ > 0 is "
+        "unstable; all Re λ < 0 is asymptotically stable; K symmetric and positive definite is "
+        "stable by the potential (Lagrange–Dirichlet) when the velocity-dependent forces do no "
+        "positive work (their power Σ Q_j q̇_j is 0 or ≤ 0), and undecided when it has no "
+        "sign; a K that is not symmetric (circulatory forces) has no potential behind it, so "
+        "only the eigenvalues speak; K not positive definite with every λ simple on the "
+        "imaginary axis is gyroscopically stable (only linearly: damping destroys it); what "
+        "the linear test cannot decide is marginal. "
         "The small-oscillation frequencies are the imaginary parts ω = Im λ."
     )
     lines = []

@@ -19,11 +19,24 @@ def explicit_time(expr: sp.Expr, model: Model) -> bool:
     return expr.xreplace(dummies).has(t)
 
 
+def nc_power(model: Model, work: Work) -> sp.Expr:
+    """P = Σ_j Q_j q̇_j, the rate at which the non-conservative forces change h (= E when the
+    constraints are fixed): dh/dt = P − ∂L/∂t (notes eq. 23). A Lorentz force q v × B has
+    Q ≠ 0 but P = 0 (it does no work), so E is conserved as if no force acted."""
+    if all(Q == 0 for Q in work.Q):
+        return sp.S.Zero
+    power = sp.expand(sum(Q * qd for Q, qd in zip(work.Q, model.qd, strict=True)))
+    if power != 0 and sp.count_ops(power) <= 400:
+        power = tidy(power, model)
+    return power
+
+
 def conserved_quantities(model: Model, work: Work) -> Step:
     lines: list[Line] = []
     found: list[dict] = []
     no_nc = all(Q == 0 for Q in work.Q)
-    if no_nc and not explicit_time(work.L, model):
+    no_work = no_nc or nc_power(model, work) == 0
+    if no_work and not explicit_time(work.L, model):
         h = tidy(sum(qd * p for qd, p in zip(model.qd, work.momenta, strict=True)) - work.L, model)
         E = tidy(work.T + work.V, model)
         if sp.expand(h - E) == 0 or tidy(h - E, model) == 0:
@@ -53,7 +66,14 @@ def conserved_quantities(model: Model, work: Work) -> Step:
             )
     work.conserved = found
     parts = []
-    if any(c["name"] == "energy" for c in found):
+    if any(c["name"] == "energy" for c in found) and not no_nc:
+        parts.append(
+            "$L$ has no explicit $t$, and the non-conservative forces' power "
+            r"$\sum_j Q_j \dot q_j$ simplifies to 0: they do no work (gyroscopic, like a "
+            r"magnetic force), so $E = T + V$ is conserved ($dE/dt = \sum_j Q_j \dot q_j = 0$, "
+            "eq. 23)."
+        )
+    elif any(c["name"] == "energy" for c in found):
         parts.append(
             "$L$ has no explicit $t$ and no non-conservative force acts, so $E = T + V$ is "
             r"conserved ($\Delta T + \Delta V = 0$, notes III)."
@@ -61,9 +81,15 @@ def conserved_quantities(model: Model, work: Work) -> Step:
     elif any(c["name"] == "jacobi" for c in found):
         parts.append(
             "The constraints move, so $T + V$ is not conserved, but $L$ has no explicit $t$: "
-            r"the Jacobi integral $h = \sum_j \dot q_j\, \partial L/\partial \dot q_j - L$ is."
+            r"the Jacobi integral $h = \sum_j \dot q_j\, \partial L/\partial \dot q_j - L$ is"
+            + (
+                "."
+                if no_nc
+                else r" (the non-conservative forces' power $\sum_j Q_j \dot q_j$ simplifies "
+                "to 0: they do no work)."
+            )
         )
-    elif not no_nc:
+    elif not no_work:
         parts.append(
             r"Non-conservative forces do work: $dE/dt = \sum_j Q_j \dot q_j$, so $E$ changes by "
             r"$W^{NC}$ (eq. 23)."

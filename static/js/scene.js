@@ -14,7 +14,7 @@ import { nameText } from "./texnames.js";
 import { Stage } from "./draw.js";
 import { showEquilibria } from "./equilibria.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
-import { isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
+import { fmt, isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
 import { Lecture } from "./lecture.js";
 import { LiveModel, PREVIEW_LABEL, forDisplay } from "./live.js";
 import { BodyDrag } from "./livedrag.js";
@@ -346,8 +346,11 @@ class SceneView {
     } else {
       b.dataset.kind = "server";
       const s = this.settings;
-      const how = isFixed(st.method) ? `dt = ${s.dt} s` : `rtol = atol = ${s.tol}`;
-      const drawn = st.display_factor > 1 ? `; ${SERVER_FPS} samples/s, drawn at ${SERVER_FPS * st.display_factor} by interpolation` : "";
+      // the step the server took (stats.dt) and the samples it sent: a fixed step samples every
+      // whole number of steps near 1/fps, so its rate is not always SERVER_FPS
+      const how = isFixed(st.method) ? `dt = ${st.dt ?? s.dt} s` : `rtol = atol = ${s.tol}`;
+      const rate = st.sample_interval ? 1 / st.sample_interval : SERVER_FPS;
+      const drawn = st.display_factor > 1 ? `; ${fmt(rate, 3)} samples/s, drawn at ${fmt(rate * st.display_factor, 3)} by interpolation` : "";
       // in lecture mode (24 px type beside a narrow canvas) the short form: the full one pushed
       // the play controls off a 1280×720 projector; the full one stays in its tooltip
       b.textContent = document.body.classList.contains("lecture")
