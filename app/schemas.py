@@ -23,8 +23,9 @@ SceneId = Annotated[str, StringConstraints(pattern=r"^[a-z0-9_]{1,64}$")]
 MethodName = Literal[tuple(METHODS)]  # type: ignore[valid-type]
 Quantity = Literal[QUANTITIES]  # type: ignore[valid-type]
 #: A number a request may carry: NaN and ±Infinity (which Python's JSON reader accepts) are a 422
-#: "Input should be a finite number" on their field, said before any range the field has.
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+#: "Input should be a finite number" on their field, said before any range the field has. Strict:
+#: JSON true is not 1 and "3" is not 3 (``"t_end": true`` ran as a 1 s run).
+Finite = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 
 
 class ErrorDetail(BaseModel):
@@ -204,7 +205,11 @@ class SimulateRequest(DeriveRequest):
     )
     rtol: Finite = Field(default=1e-9, description="Relative tolerance (adaptive methods).")
     atol: Finite = Field(default=1e-9, description="Absolute tolerance (adaptive methods).")
-    dt: Finite | None = Field(default=None, description="Step (fixed-step methods).")
+    dt: Finite | None = Field(
+        default=None,
+        description="Step (fixed-step methods), ≤ t_end: the run takes exactly this step, and "
+        "samples every whole number of steps near 1/fps (`t` holds the times).",
+    )
     check_sensitivity: bool = Field(
         default=True,
         description="Re-run at a 1000× looser tolerance and warn if the motion is sensitive.",
@@ -248,6 +253,16 @@ class SimulateStats(BaseModel):
     jacobian_evaluations: int
     wall_time: float = Field(description="Seconds spent integrating.")
     samples: int
+    sample_interval: float | None = Field(
+        default=None,
+        description="Seconds between two samples: 1/fps for adaptive methods; for fixed-step "
+        "ones a whole number of steps dt near 1/fps (null with a single sample).",
+    )
+    dt: float | None = Field(
+        default=None,
+        description="The step a fixed-step method took: exactly the dt asked for (the samples "
+        "are whole steps apart). Absent for adaptive methods.",
+    )
     status: str = Field(description="ok, or stopped (see warnings).")
     driven: bool = Field(
         default=False,

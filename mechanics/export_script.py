@@ -158,6 +158,7 @@ def script_source(
         f"DT = {None if options.dt is None else float(options.dt)!r}",
         f"T_END = {float(options.t_end)!r}",
         f"FPS = {float(options.fps)!r}",
+        *_fixed_grid_constants(options, fixed),
         f"STOPS_NOT_MODELLED = {stops!r}",
     ]
     return _TEMPLATE.format(
@@ -219,6 +220,19 @@ def fixed_step_source(method: str) -> str:
     if method == "implicit_midpoint":  # it checks finiteness and may give up
         parts += [inspect.getsource(integrators._finite), inspect.getsource(integrators._Stop)]
     return "\n\n".join(parts) + _FIXED_LOOP.replace("STEPPER", stepper.__name__)
+
+
+def _fixed_grid_constants(options: Any, fixed: bool) -> list[str]:
+    """The sample grid of a fixed-step run as /simulate builds it (whole steps of dt apart)."""
+    if not fixed:
+        return ["SAMPLE_STEPS = None  # adaptive: samples 1/FPS apart", "SAMPLE_COUNT = None"]
+    from mechanics.simulate import fixed_step_grid
+
+    times, stride = fixed_step_grid(options.t_end, options.fps, options.dt)
+    return [
+        f"SAMPLE_STEPS = {stride!r}  # steps of DT between two samples (about 1/FPS)",
+        f"SAMPLE_COUNT = {len(times)!r}",
+    ]
 
 
 _FIXED_LOOP = '''
@@ -287,7 +301,10 @@ def derivatives(t, y):
 {integrator}
 
 def sample_times():
-    """The app's output samples: t_end * fps + 1 of them (the last at or before T_END)."""
+    """The app's output samples: t_end * fps + 1 of them (the last at or before T_END); for a
+    fixed step, SAMPLE_COUNT samples every SAMPLE_STEPS steps of exactly DT."""
+    if SAMPLE_STEPS is not None:
+        return np.arange(SAMPLE_COUNT) * (SAMPLE_STEPS * DT)
     count = int(math.floor(T_END * FPS + 1e-9)) + 1
     return np.linspace(0.0, (count - 1) / FPS, count)
 

@@ -99,6 +99,9 @@ class Trajectory:
     wall_time: float  # seconds
     note: str = ""  # how the method ran, when not as named (e.g. no C compiler: scipy's DOP853)
     t_reached: float = math.nan  # how far the stepping got (past the last sample when stopped)
+    #: A fixed-step method's largest step (NaN for adaptive ones): the step actually taken, which
+    #: is dt itself when the output times are whole multiples of dt apart.
+    step: float = math.nan
 
     def __post_init__(self) -> None:
         # Counters reach the JSON of a response: plain Python numbers, whatever counted them
@@ -185,6 +188,7 @@ class _Run:
 
     def __init__(self, y0: np.ndarray) -> None:
         self.out, self.nsteps, self.njev = [y0.copy()], 0, 0
+        self.step = math.nan  # the largest fixed step taken
 
 
 def integrate(
@@ -206,9 +210,11 @@ def integrate(
 
     Fixed-step methods need ``dt``; they land exactly on every output time (each interval gets
     ⌈Δt/dt⌉ equal steps of size ≤ dt), so every sample is a genuine step of the method, never
-    an interpolation. Adaptive methods use ``rtol``/``atol`` and sample by the solver's own
-    dense output. ``second_order`` = n says y = [q (n), v (n), extra...] with dq/dt = v;
-    symplectic Euler needs that split (None means y = [q, v] in halves). Extra states (e.g.
+    an interpolation. Output times whole multiples of dt apart keep the step dt itself (what
+    `mechanics.simulate` asks for); ``Trajectory.step`` says the largest step taken. Adaptive
+    methods use ``rtol``/``atol`` and sample by the solver's own dense output.
+    ``second_order`` = n says y = [q (n), v (n), extra...] with dq/dt = v; symplectic Euler
+    needs that split (None means y = [q, v] in halves). Extra states (e.g.
     the work of non-conservative forces) ride along with the method's update.
 
     ``dop853_c`` steps in C: with ``native`` (the scene's generated C right-hand side, the same
@@ -272,6 +278,7 @@ def integrate(
         time.perf_counter() - start,
         note,
         f.t if status != "ok" else float(t_eval[-1]),
+        run.step,
     )
 
 
@@ -327,6 +334,7 @@ def _fixed(run: _Run, step, f: _Counted, t_eval, dt, max_steps, n) -> None:
         t0, t1 = t_eval[k - 1], t_eval[k]
         m = max(1, math.ceil((t1 - t0) / dt - 1e-9))  # tolerate Δt/dt = 10.000000000002
         h = (t1 - t0) / m
+        run.step = h if math.isnan(run.step) else max(run.step, h)
         for i in range(m):
             if run.nsteps >= max_steps:
                 raise _Stop(f"step budget ({max_steps}) exhausted at t = {t0 + i * h:.6g} s")

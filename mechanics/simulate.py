@@ -105,6 +105,15 @@ def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float]
         checks.append(("dt", ok, "a fixed-step method needs a step dt > 0"))
         if ok and req.t_end / req.dt > MAX_FIXED_STEPS:
             checks.append(("dt", False, f"t_end / dt exceeds {MAX_FIXED_STEPS} steps"))
+        elif ok and math.isfinite(req.t_end) and 0 < req.t_end < req.dt * (1 - 1e-9):
+            checks.append(
+                (
+                    "dt",
+                    False,
+                    f"must be ≤ t_end = {req.t_end:g} s: a step of dt = {req.dt:g} s would "
+                    "end past the run, so not one step of it fits",
+                )
+            )
     errors += [{"field": f, "message": m} for f, ok, m in checks if not ok]
     if errors:
         raise SpecError(errors)
@@ -329,21 +338,67 @@ def _run(
     return run
 
 
+def fixed_step_grid(t_end: float, fps: float, dt: float) -> tuple[np.ndarray, int]:
+    """Sample times for a fixed-step run, and the steps between two samples.
+
+    The run takes exactly the step asked for: a student picks dt to see what it costs and how
+    accurate it is, and steps squeezed to land on a 1/fps grid would be another method's run.
+    So the samples are every `stride` steps, a whole number near 1/(fps·dt) (one step when dt
+    is longer than 1/fps), preferably one that divides the steps to t_end, so the last sample
+    is the last step. The sample spacing is then stride·dt, not 1/fps: clients read the times
+    from ``t``.
+    """
+    total = math.floor(t_end / dt + 1e-9)  # whole steps of dt within t_end
+    if total < 1:
+        return np.zeros(1), 1
+    ideal = 1.0 / (fps * dt)
+    fewest = math.ceil(total / (MAX_SAMPLES - 1))  # the smallest stride within MAX_SAMPLES
+    stride = max(1, round(ideal), fewest)
+    if ideal > 1:  # divisors of `total` within a factor 2 of the ideal, nearest (in ratio) first
+        lo, hi = max(1, math.ceil(ideal / 2), fewest), min(total, math.floor(2 * ideal))
+        candidates = [d for d in range(lo, min(hi, lo + 4000) + 1) if total % d == 0]
+        if candidates:
+            stride = min(candidates, key=lambda d: abs(math.log(d / ideal)))
+    n = total // stride + 1
+    return np.arange(n) * (stride * dt), stride
+
+
+def _sample_times(req: SimulationRequest) -> np.ndarray:
+    if METHODS[req.method].kind == "fixed":
+        return fixed_step_grid(req.t_end, req.fps, req.dt)[0]
+    n_samples = int(math.floor(req.t_end * req.fps + 1e-9)) + 1
+    return np.linspace(0.0, (n_samples - 1) / req.fps, n_samples)
+
+
+def _where_samples_end(req: SimulationRequest, t_eval: np.ndarray) -> list[str]:
+    """Say where the samples end when it is short of t_end (they start at 0 on a fixed grid)."""
+    short = req.t_end - float(t_eval[-1])
+    if not short > 1e-9 * max(1.0, req.t_end):
+        return []
+    if METHODS[req.method].kind == "fixed":
+        spacing = float(t_eval[1] - t_eval[0]) if len(t_eval) > 1 else req.dt
+        stride = max(1, round(spacing / req.dt))
+        return [
+            f"The steps are dt = {req.dt:.6g} s and the samples every {stride} step"
+            f"{'s' if stride > 1 else ''} ({spacing:.4g} s apart), so the run ends at the last "
+            f"sample, t = {t_eval[-1]:.6g} s, {short:.3g} s short of t_end = {req.t_end:.6g} s: "
+            "ask for a t_end that is a whole number of steps to get the state at t_end."
+        ]
+    return [
+        f"Samples are 1/fps = {1 / req.fps:.4g} s apart, so the last is at "
+        f"t = {t_eval[-1]:.6g} s, {short:.3g} s short of t_end = {req.t_end:.6g} s: ask for "
+        "a t_end that is a multiple of 1/fps (or a higher fps) to get the state at t_end."
+    ]
+
+
 def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any]:
     params, y0 = check_request(c, req)
-    n_samples = int(math.floor(req.t_end * req.fps + 1e-9)) + 1
-    t_eval = np.linspace(0.0, (n_samples - 1) / req.fps, n_samples)
+    t_eval = _sample_times(req)
     refuse_passed_stops(c, params, y0)
     at_start = stopped_at_start(c, params, y0, req.t_end)
     run = _run(c, params, y0, t_eval[:1] if at_start else t_eval, req, req.rtol, req.atol)
     warnings: list[str] = [run.note] if run.note else []
-    short = req.t_end - float(t_eval[-1])
-    if short > 1e-9 * max(1.0, req.t_end):  # samples are 1/fps apart from 0: say where they end
-        warnings.append(
-            f"Samples are 1/fps = {1 / req.fps:.4g} s apart, so the last is at "
-            f"t = {t_eval[-1]:.6g} s, {short:.3g} s short of t_end = {req.t_end:.6g} s: ask for "
-            "a t_end that is a multiple of 1/fps (or a higher fps) to get the state at t_end."
-        )
+    warnings += _where_samples_end(req, t_eval)
     raw = run
     if at_start is not None:
         run.status, run.message = "stopped", f"{at_start.name} at t = 0 s"
@@ -394,9 +449,17 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         "jacobian_evaluations": run.njev,
         "wall_time": run.wall_time,
         "samples": len(t),
+        "sample_interval": float(t_eval[1] - t_eval[0]) if len(t_eval) > 1 else None,
         "status": run.status,
         "driven": c.drive is not None,
     }
+    if METHODS[req.method].kind == "fixed":
+        # the step the run took, dt to rounding (samples are whole steps apart); the asked dt
+        # when no step was taken (a zero-length run, a stop at t = 0)
+        taken = run.step if math.isfinite(run.step) else req.dt
+        stats["dt"] = req.dt if abs(taken - req.dt) <= 1e-9 * req.dt else taken
+        if stats["dt"] != req.dt:  # the grid is built so that this never happens
+            warnings.append(f"The step taken was {taken:.6g} s, not dt = {req.dt:.6g} s.")
     if stop is not None:
         stats["stop"] = {"name": stop.name, "t": stop.t, "message": stop.message}
     scale = max(float(np.max(np.abs(T[:measured]))) if len(T) else 0.0, 1e-300)

@@ -149,8 +149,9 @@ def test_trajectory_json_of_a_posted_spec_carries_stats_and_units():
     assert r.status_code == 200, r.text
     doc = r.json()
     assert doc["t"] == run["t"] and doc["q"] == run["q"] and doc["energy"] == run["energy"]
-    # 60 output intervals of 1/60 s, each ⌈(1/60)/0.01⌉ = 2 equal steps of rk4
-    assert doc["stats"]["method"] == "rk4" and doc["stats"]["steps"] == 120
+    # rk4 takes exactly dt = 0.01: t_end / dt = 100 steps, the step stated in the stats
+    assert doc["stats"]["method"] == "rk4" and doc["stats"]["steps"] == 100
+    assert doc["stats"]["dt"] == 0.01
     assert {"name": "theta", "unit": spec["units"]["theta"]} in doc["columns"]
     assert doc["request"]["dt"] == 0.01 and doc["request"]["scene"] == "My pendulum"
 

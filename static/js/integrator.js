@@ -80,6 +80,8 @@ export function showStats(runs) {
   const table = $("stats");
   const rows = [
     ["method", (r) => r.stats.method],
+    // the step the server took (fixed-step methods): exactly the dt asked for
+    ["step dt", (r) => (r.stats.dt != null ? `${fmt(r.stats.dt)} s` : "adaptive")],
     ["wall time", (r) => `${fmt(r.stats.wall_time * 1e3, 3)} ms`],
     ["steps", (r) => r.stats.steps.toLocaleString("en")],
     ["RHS evaluations", (r) => r.stats.rhs_evaluations.toLocaleString("en")],
