@@ -44,6 +44,10 @@ export class Stage {
     const w = Math.max(200, Math.round(this.canvas.clientWidth || 640));
     const h = Math.round(w * (this.aspect || ASPECT));
     const dpr = window.devicePixelRatio || 1;
+    // on-screen pixels per canvas pixel: below 1 where the canvas is shown shrunk to fit a short
+    // screen's height (lecture mode's max-height, object-fit: contain); read here, not per frame
+    const shownH = this.canvas.clientHeight;
+    this.shownScale = shownH && h ? Math.min(1, shownH / h) : 1;
     if (this.canvas.width === Math.round(w * dpr) && this.cssW === w && this.cssH === h) return;
     this.cssW = w;
     this.cssH = h;
@@ -160,9 +164,13 @@ export class Stage {
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.setTransform(this.dpr, 0, 0, this.dpr, 0, 0);
-    const font = document.body.classList.contains("lecture") ? 17 : 12;
+    // lecture mode: labels (a body's name, a spring's, the scale bar's "50 cm", which is drawn a
+    // pixel smaller) at least 24 px on the screen, read from the back of a hall; bodies keep
+    // their size
+    const lecture = document.body.classList.contains("lecture");
+    const font = lecture ? Math.ceil(25 / (this.shownScale || 1)) : 12;
     const shapes = sceneShapes(g, this.view, this.frame, {
-      radius: font - 1, trail: g.is3D ? 3 : 1.5, scaleBar: true, font,
+      radius: lecture ? 16 : 11, trail: g.is3D ? 3 : 1.5, scaleBar: true, font,
     });
     const turn = this.placeable() ? ["drag a body to place it,", "drag elsewhere to turn the view"] : ["drag to turn the view"];
     const note = g.is3D ? turn : this.follow ? ["camera follows the motion"] : [];

@@ -3,7 +3,7 @@
 // stopwatch and a period timer that read the simulation's clock (not the wall clock: at 0.25×
 // speed a period still measures what it is; a period only where the coordinate swings steadily,
 // else why there is none), gravity presets that move the scene's own gravity
-// control the way a user would, and single steps (one sample back or forward, buttons and the
+// control the way a user would, and single steps (one measured sample back or forward, buttons and the
 // , and . keys while paused). Built from JS next to the stage's canvas; styled inline, so the page's
 // stylesheet needs nothing new. Data attributes (data-value, data-t, data-period, ...) let the
 // browser tests read what is shown.
@@ -28,6 +28,12 @@ const el = (tag, props = {}, style = "") => {
   const e = Object.assign(document.createElement(tag), props);
   if (style) e.style.cssText = style;
   return e;
+};
+/** `v.toFixed(digits)` without a minus on a number that rounds to zero: a mean of −0.00004 is
+ * "0.000", never "-0.000". */
+export const fixed = (v, digits) => {
+  const s = v.toFixed(digits);
+  return /^-0(\.0*)?$/.test(s) ? s.slice(1) : s;
 };
 // four significant digits, plain up to 10⁵ J (737.3, not 7.37e+2 beside 2.583)
 const fmtJ = (v) => (Math.abs(v) >= 1e5 || (Math.abs(v) < 0.01 && v !== 0) ? v.toExponential(2) : v.toPrecision(4));
@@ -88,15 +94,22 @@ export class Instruments {
   }
 
   /** One sample back or forward: through the page's time slider (it pauses the playback and sets
-   * the clock), given the exact time of the sample so a long run is not rounded to 1/1000. */
+   * the clock), given the exact time of the sample so a long run is not rounded to 1/1000.
+   * A sample the server measured (`sampled` of a run drawn with interpolated frames between its
+   * samples, live.js forDisplay): the free-body diagram, drawn from those samples, then shows the
+   * instant the canvas and the clock show. */
   step(by) {
-    const r = this.result, scrub = document.getElementById("scrub");
-    if (!r || !scrub || r.t.length < 2) return;
-    const end = r.t[r.t.length - 1];
+    const shown = this.result, scrub = document.getElementById("scrub");
+    if (!shown || !scrub || shown.t.length < 2) return;
+    const r = shown.sampled || shown;
+    const factor = shown.sampled ? (shown.stats?.display_factor || 1) : 1;
+    const end = shown.t[shown.t.length - 1];
     // keys pressed faster than frames are drawn step on from the last step, not the stale frame
     const recent = this.stepped && performance.now() - this.stepped.at < 300;
-    const from = recent ? this.stepped.to : this.stage.frame;
-    const target = Math.max(0, Math.min(r.t.length - 1, from + by));
+    const at = this.stage.frame / factor; // between two samples on an interpolated frame
+    const from = recent ? this.stepped.to : at;
+    const next = by > 0 ? Math.floor(from + 1e-9) + by : Math.ceil(from - 1e-9) + by;
+    const target = Math.max(0, Math.min(r.t.length - 1, next));
     this.stepped = { to: target, at: performance.now() };
     scrub.step = "any";
     scrub.value = String(end > 0 ? (1000 * r.t[target]) / end : 0);
@@ -144,14 +157,17 @@ export class Instruments {
     const shownWidth = Math.round(this.svg.getBoundingClientRect().width);
     this.drawnWidth = shownWidth;
     const W = Math.max(160, shownWidth || 300);
-    const small = 9.5 * u, label = 12 * u;
+    // lecture mode: every label 24 px (the back of a hall), and the bars on their side, one row
+    // each, so a value never shrinks to fit a narrow upright slot
+    const lecture = document.documentElement.classList.contains("lecture");
+    const small = lecture ? 24 : 9.5 * u, label = lecture ? 24 : 12 * u;
     const parts = [];
     const line = (x1, y1, x2, y2, color) =>
       `<line x1="${x1.toFixed(1)}" y1="${y1.toFixed(1)}" x2="${x2.toFixed(1)}" y2="${y2.toFixed(1)}" stroke="${color}"/>`;
     // A narrow panel (beside the animation) lays the bars on their side, one row each, with
     // their values in a column of their own: upright bars there had slots too narrow for
     // their value labels ("-21.774" over "0.149").
-    const across = W < 17 * 16 * u;
+    const across = lecture || W < 17 * 16 * u;
     if (across) {
       // each row: the name and the value on a line, the bar under them across the full width
       const top = 2 * u, barH = 10 * u, rowH = label + barH + 8 * u, pad = 4 * u;
@@ -315,11 +331,12 @@ export class Instruments {
       out.textContent = "–";
     } else {
       const period = (seen[seen.length - 1][1] - seen[0][1]) / (seen.length - 1);
-      out.textContent = `T ≈ ${period.toFixed(3)} s`;
+      // "period", not T: T is the kinetic energy on this page (the bar just above)
+      out.textContent = `period ≈ ${period.toFixed(3)} s`;
       out.dataset.period = String(period);
     }
     const n = Math.max(0, seen.length - 1);
-    this.periodNote.textContent = `Counts ${nameText(name)} rising through its mean over the run (${sw.mean.toFixed(3)})` +
+    this.periodNote.textContent = `Counts ${nameText(name)} rising through its mean over the run (${fixed(sw.mean, 3)})` +
       `: ${n} full period${n === 1 ? "" : "s"} so far` +
       (sw.kind === "once" ? "; the run holds one swing only, so it is not yet seen to repeat." : ".") + tail;
   }
@@ -396,6 +413,13 @@ export class Instruments {
     this.watch.last = null;
   }
 
+  /** The page's type size changed (lecture mode on or off): the bars drawn again at it. */
+  relayout() {
+    if (!this.result) return;
+    this.#buildBars();
+    this.#updateBars(this.stage.frame);
+  }
+
   /** The sample on screen changed (called by the stage every frame it draws). */
   update(i) {
     const r = this.result;
@@ -467,7 +491,7 @@ export function swings(t, q) {
     if (rises || falls) {
       return { ...base, kind: "monotonic", reason: `only ${rises ? "rises" : "falls"} over this run (from ${q[0].toPrecision(3)} to ${q[n - 1].toPrecision(3)}): it does not swing back, so there is no period to time.` };
     }
-    return { ...base, kind: "few", reason: `turns back, but does not rise through its mean (${mean.toFixed(3)}) twice in this run of ${span.toFixed(2)} s: no full swing to time (if it does swing, its period is longer than the run: raise t_end).` };
+    return { ...base, kind: "few", reason: `turns back, but does not rise through its mean (${fixed(mean, 3)}) twice in this run of ${span.toFixed(2)} s: no full swing to time (if it does swing, its period is longer than the run: raise t_end).` };
   }
   if (ups.length === 2) return { ...base, kind: "once", reason: "" };
   const gaps = ups.slice(1).map(([, b], j) => b - ups[j][1]);

@@ -2,22 +2,31 @@
 // time (→, space, PageDown reveal the next; ←, PageUp hide it), p plays or pauses, f full screen.
 // A step taller than the screen (a double pendulum's Euler–Lagrange step is three screens) is paged
 // through first: the same keys scroll it a screen at a time before the next step is revealed, and
-// the counter says when more of it lies below.
+// the counter says when more of it lies below. The counter sits in the sticky header in lecture
+// mode, so the room always sees where it is; the page's address keeps the step (?step=, from 0),
+// and a link with one opens scrolled to that step.
 // The derivation stands beside the animation, so in lecture mode it is moved next to it in the
 // page too: the tab order and a screen reader follow what the room sees. Its equations are fitted
 // to the narrower column (fit.js).
 import { fitEquations, watchEquations } from "./fit.js";
 
 export class Lecture {
-  constructor({ list, toggle, counter, onToggle, onPlay }) {
+  constructor({ list, toggle, counter, onToggle, onPlay, onStep }) {
     this.list = list;
     this.toggle = toggle;
     this.counter = counter;
     this.onToggle = onToggle;
     this.onPlay = onPlay;
+    this.onStep = onStep;
     this.revealed = 1;
     this.section = list.closest(".derivation");
     this.home = this.section ? { parent: this.section.parentNode, next: this.section.nextSibling } : null;
+    this.counterHome = counter ? { parent: counter.parentNode, next: counter.nextSibling } : null;
+    // a step opened from a link is aligned again once the math above it is typeset, unless the
+    // reader moved first (settle())
+    for (const type of ["keydown", "wheel", "touchstart", "pointerdown"]) {
+      window.addEventListener(type, () => { this.linked = false; }, { passive: true, capture: true });
+    }
     watchEquations(list);
     if (toggle) toggle.addEventListener("click", () => this.set(!this.on));
     document.addEventListener("keydown", (e) => this.#key(e));
@@ -45,8 +54,15 @@ export class Lecture {
     this.onToggle?.(on);
   }
 
-  /** The derivation right after the animation's column in lecture mode, back home otherwise. */
+  /** The derivation right after the animation's column in lecture mode, back home otherwise; the
+   * step counter in the sticky header (before the lecture toggle) while in lecture mode: in the
+   * derivation's heading it scrolled away at the first key press. */
   #place(on) {
+    const header = document.querySelector("body > header");
+    if (this.counter && header) {
+      if (on && this.counter.parentNode !== header) header.insertBefore(this.counter, this.toggle?.parentNode === header ? this.toggle : null);
+      else if (!on && this.counter.parentNode === header) this.counterHome.parent.insertBefore(this.counter, this.counterHome.next);
+    }
     const main = this.home && this.home.parent.querySelector(":scope > .col-main");
     if (!main) return;
     if (on && main.nextSibling !== this.section) main.after(this.section);
@@ -125,7 +141,26 @@ export class Lecture {
 
   step(delta) {
     this.revealed += delta;
-    return this.apply(delta < 0 ? "end" : true);
+    const shown = this.apply(delta < 0 ? "end" : true);
+    this.onStep?.(this.revealed);
+    return shown;
+  }
+
+  /** Open at step `n` (from 1) of a link, scrolled to it (its title just under the header). */
+  open(n) {
+    this.revealed = n;
+    this.linked = this.on && n > 1;
+    return this.apply(this.linked ? "top" : false);
+  }
+
+  /** The math above a linked step was typeset (and moved it): bring it back under the header,
+   * unless the reader has pressed, scrolled or touched anything since it opened. */
+  settle() {
+    if (!this.linked || !this.on) return;
+    this.linked = false;
+    const current = this.#current();
+    if (current) window.scrollBy(0, current.getBoundingClientRect().top - this.#headerBottom() - 8);
+    this.#count();
   }
 
   #current() {
@@ -156,8 +191,11 @@ export class Lecture {
   }
 
   /** Show the first `revealed` steps (all of them outside lecture mode); `scroll` brings the
-   * current one into view, its start (a step just revealed) or its end ("end": back from the
-   * next step, where the room left it). */
+   * current one into view: its start (a step just revealed), its title under the header ("top":
+   * a linked step), or, back from the next step ("end"), the whole of it with its title under
+   * the header when it fits the screen, else its last screen (where the room left it; ← then
+   * pages back up through it). Hiding the next step shortens the page, and the browser clamps
+   * the scroll to it: the step shown was left with its last line under the header. */
   apply(scroll = false) {
     const steps = [...this.list.querySelectorAll(":scope > .step")];
     this.revealed = Math.max(1, Math.min(this.revealed, steps.length || 1));
@@ -172,9 +210,13 @@ export class Lecture {
       if (!scroll || !this.on || !last) return;
       // a step just revealed starts under the header (all of it when it fits below what is shown)
       const r = last.getBoundingClientRect(), top = this.#headerBottom();
-      if (scroll === "end" && (r.bottom > innerHeight || r.bottom < top)) {
-        window.scrollBy(0, Math.max(r.bottom - innerHeight + 16, r.top - top - 8));
-      } else if (scroll !== "end" && (r.top < top || r.bottom > innerHeight)) {
+      const whole = r.top >= top && r.bottom <= innerHeight;
+      if (scroll === "top") {
+        window.scrollBy(0, r.top - top - 8);
+      } else if (scroll === "end" && !whole) {
+        const fits = r.height <= innerHeight - top - 16;
+        window.scrollBy(0, fits ? r.top - top - 8 : r.bottom - innerHeight + 16);
+      } else if (scroll !== "end" && !whole) {
         window.scrollBy(0, r.top - top - 8);
       }
       this.#count();

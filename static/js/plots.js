@@ -1,6 +1,8 @@
 // q(t), the phase portrait of one coordinate (q_j against q̇_j), and the energies T, V, E (and the
 // work W_NC of non-conservative forces) against time, with plotly served by the app (no CDN).
-// In compare mode the energy plot shows both runs' energy error instead.
+// In compare mode the energy plot shows both runs' energy error instead. Coordinates are named as
+// the page writes them (θ̇₁, not theta1_dot: texnames.js), and lecture mode's type is 24 px.
+import { nameText } from "./texnames.js";
 
 // No "share to Plotly Cloud" (plotly.js 4 offers it by default: an upload off the machine), no logo,
 // no selection tools (nothing here uses a selection). The toolbar's buttons are kept out of the
@@ -30,14 +32,14 @@ export function layout(title, x, y, lecture) {
     // gets room (automargin) instead of being clipped. The legend sits at the figure's foot in
     // container coordinates: plotly then adds its height (two rows on a phone) to the bottom
     // margin under the axis title; placed below the plot area (paper y < 0) it covered the title.
-    title: { text: title, font: { size: lecture ? 22 : 14 }, automargin: true, x: 0.02, xanchor: "left" },
-    margin: { l: 62, r: 14, t: lecture ? 56 : 44, b: lecture ? 64 : 52 },
-    legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0, font: { size: lecture ? 20 : 11 } },
-    font: { size: lecture ? 20 : 12, color: ink },
+    title: { text: title, font: { size: lecture ? 26 : 14 }, automargin: true, x: 0.02, xanchor: "left" },
+    margin: { l: lecture ? 76 : 62, r: 14, t: lecture ? 60 : 44, b: lecture ? 70 : 52 },
+    legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0, font: { size: lecture ? 24 : 11 } },
+    font: { size: lecture ? 24 : 12, color: ink },
     paper_bgcolor: "rgba(0,0,0,0)",
     plot_bgcolor: "rgba(0,0,0,0)",
     xaxis: { title: { text: x }, gridcolor: grid, zerolinecolor: grid, automargin: true },
-    yaxis: { title: { text: y }, gridcolor: grid, zerolinecolor: grid, exponentformat: "power" },
+    yaxis: { title: { text: y }, gridcolor: grid, zerolinecolor: grid, exponentformat: "power", automargin: true },
   };
 }
 
@@ -56,15 +58,16 @@ export function plotRun({ a, b, labels, spec, phase, lecture }) {
   const t = a.t;
   const same = new Set(names.map((n) => units[n] || "")).size === 1;
   const yq = same && units[names[0]] ? `q (${units[names[0]]})` : "q";
-  P.react("plot-q", names.map((n) => ({ x: t, y: a.q[n], name: n, mode: "lines", line: { width: 2 } })),
+  P.react("plot-q", names.map((n) => ({ x: t, y: a.q[n], name: nameText(n), mode: "lines", line: { width: 2 } })),
     layout("coordinates q(t)", "t (s)", yq, lecture), CONFIG);
   const q = names.includes(phase) ? phase : names[0];
-  const traces = [{ x: a.q[q], y: a.q_dot[q], name: b ? `A: ${labels[0]}` : q, mode: "lines", line: { width: 1.8 } }];
+  const traces = [{ x: a.q[q], y: a.q_dot[q], name: b ? `A: ${labels[0]}` : nameText(q), mode: "lines", line: { width: 1.8 } }];
   if (b) traces.push({ x: b.q[q], y: b.q_dot[q], name: `B: ${labels[1]}`, mode: "lines", line: { width: 1.4, dash: "dot" } });
   traces.push({ x: [a.q[q][0]], y: [a.q_dot[q][0]], name: "start", mode: "markers", marker: { size: 9, color: "#d9480f" } });
   const uq = units[q];
   P.react("plot-phase", traces,
-    layout(`phase portrait of ${q}`, `${q}${unitOf(units, q)}`, `${q}_dot${uq ? ` (${uq}/s)` : ""}`, lecture), CONFIG);
+    layout(`phase portrait of ${nameText(q)}`, `${nameText(q)}${unitOf(units, q)}`,
+      `${nameText(`${q}_dot`)}${uq ? ` (${uq}/s)` : ""}`, lecture), CONFIG);
   const e = a.energy;
   let energy;
   let title = "energy";

@@ -13,6 +13,7 @@ import { renderSteps } from "./derivation.js";
 import { nameText } from "./texnames.js";
 import { Stage } from "./draw.js";
 import { showEquilibria } from "./equilibria.js";
+import { fitEquations } from "./fit.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
 import { fmt, isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
 import { Lecture } from "./lecture.js";
@@ -96,8 +97,13 @@ class SceneView {
     this.#playback();
     this.lecture = new Lecture({
       list: $("steps"), toggle: $("lecture-toggle"), counter: $("step-counter"),
-      onToggle: () => { this.#saveURL(); this.#plot(); this.#label(this.shown); },
+      onToggle: () => {
+        this.#saveURL(); this.#plot(); this.#label(this.shown);
+        this.stageA.instruments?.relayout(); // the bars' labels at the lecture size, or back
+        this.fbd(true); // and the diagram's
+      },
       onPlay: () => this.togglePlay(),
+      onStep: () => this.#saveURL(), // the address bar keeps the step the room is at
     });
     // a share link's lecture step (0: the first), revealed once the steps are there
     const step = query.has("step") ? Number(query.get("step")) : NaN;
@@ -204,7 +210,8 @@ class SceneView {
       lecture: this.lecture.on,
     }));
     if (this.phase && this.phase !== this.spec.coordinates[0]) q.set("phase", this.phase);
-    if (this.lecture.on) q.set("step", String(this.lecture.revealed - 1));
+    // (a link's step is kept while the derivation it waits for is on its way)
+    if (this.lecture.on) q.set("step", String((this.wantedSteps || this.lecture.revealed) - 1));
     if (!this.sceneId) {
       const from = new URLSearchParams(location.search).get("from");
       if (from) q.set("from", from);
@@ -404,8 +411,20 @@ class SceneView {
 
   #setPlaying(on) {
     this.playing = on;
+    if (!on) this.#toSample();
     this.#syncPlay();
     if (!on) this.fbd(true);
+  }
+
+  /** Paused (or scrubbed, or stepped): the clock goes to the nearest sample the server measured.
+   * The canvas draws frames interpolated between samples (forDisplay), the free-body diagram
+   * only the samples (its forces are the run's): held between two, the diagram said
+   * t = 2.30 s under a clock at 2.28 s. On a sample, clock, canvas and diagram are one instant. */
+  #toSample() {
+    const r = this.result;
+    if (!r || r.t.length < 2 || !this.shown || this.shown.stats.preview) return;
+    this.time = r.t[this.frameIndex(r)];
+    $("clock").textContent = `t = ${this.time.toFixed(2)} s`;
   }
 
   /** 'Pause' only while something moves on the canvas: before the first run it says so. */
@@ -477,6 +496,7 @@ class SceneView {
     const kinds = drawFBD($("fbd-svg"), this.spec, this.result, this.params, this.frameIndex(this.result),
       { yaw: this.stageA.yaw, pitch: this.stageA.pitch }, placed);
     fbdLegend($("fbd-legend"), kinds);
+    if (this.lecture.on) legibleLabels($("fbd-svg"), LECTURE_LABEL_PX);
   }
 
   // ------------------------------------------------------------------ derivation, equilibria
@@ -493,8 +513,10 @@ class SceneView {
     }
     renderSteps(steps, this.derivation, { target: () => this.target(), coordinates: this.spec.coordinates });
     showWarningsBelow(this.derivation.warnings);
-    if (this.wantedSteps) [this.lecture.revealed, this.wantedSteps] = [this.wantedSteps, null];
-    this.lecture.apply();
+    if (this.wantedSteps) { // a link's step: opened there, scrolled to it
+      this.lecture.open(this.wantedSteps);
+      this.wantedSteps = null;
+    } else this.lecture.apply();
     if (this.result) this.fbd(true);
     // One step at a time with a frame between: typesetting the whole derivation at once holds the
     // main thread for half a second, during which the animation could not start or move.
@@ -541,6 +563,8 @@ class SceneView {
       const { traceTerms } = await import("./provenance.js");
       await traceTerms(steps, this.derivation.provenance);
     }
+    // the typeset math (and its tables) above a linked step moved it: back under the header
+    fitEquations(steps).then(() => this.lecture.settle());
     this.#mountExtras();
   }
 
@@ -592,6 +616,27 @@ class SceneView {
     this.changes++;
     this.preview();
     this.schedule(0);
+  }
+}
+
+/** Lecture mode's least size of a label in a drawing (CSS px): read from the back of a hall. */
+const LECTURE_LABEL_PX = 24;
+
+/** The labels of an svg drawn in its own units (the free-body diagram: 11 units, 13 px on a
+ * 1024×768 projector) brought up to `px` CSS pixels on the screen, their subscripts in proportion. */
+function legibleLabels(svg, px) {
+  const box = svg?.viewBox?.baseVal;
+  const shown = svg?.getBoundingClientRect().width;
+  if (!box || !box.width || !shown) return;
+  const k = shown / box.width; // screen px per svg unit
+  for (const text of svg.querySelectorAll("text")) {
+    const size = parseFloat(text.getAttribute("font-size")) || 12;
+    if (size * k >= px) continue;
+    const by = px / (size * k);
+    text.style.fontSize = `${(size * by).toFixed(2)}px`;
+    for (const span of text.querySelectorAll("tspan[font-size]")) {
+      span.style.fontSize = `${(parseFloat(span.getAttribute("font-size")) * by).toFixed(2)}px`;
+    }
   }
 }
 

@@ -14,13 +14,18 @@ function fmt(x) {
   return a !== 0 && (a < 1e-3 || a >= 1e5) ? x.toExponential(3) : x.toFixed(4);
 }
 
+/** What a load is called in the spec, and its kind in words: "drive (applied force)", not
+ * "force drive" (which reads as an instruction). */
+const KINDS = { spring: "spring", potential: "potential", damper: "damper", force: "applied force",
+  torque: "applied torque" };
+
 function label(key) {
   const [kind, rest] = key.split(":");
   const name = rest.split("@")[0];
   if (kind === "weight") return `weight of ${name}`;
-  if (!["spring", "potential", "damper", "force", "torque"].includes(kind)) return key;
-  // a spring named "spring" (or "spring 1") is not "spring spring": its name says its kind
-  return name.toLowerCase().startsWith(kind) ? name : `${kind} ${name}`;
+  if (!(kind in KINDS)) return key;
+  // a spring named "spring" (or "spring 1") is not "spring (spring)": its name says its kind
+  return name.toLowerCase().startsWith(kind) ? name : `${name} (${KINDS[kind]})`;
 }
 
 function index(t, time) {
@@ -64,15 +69,16 @@ export function showWork(run, { lecture = false } = {}) {
   table.dataset.gap = String(gap / scale);
   table.dataset.balanced = ok ? "1" : "0";
   table.dataset.driven = driven ? "1" : "0";
+  cueScrolling(table);
   if (typeof window.Plotly === "undefined") return;
   const ink = lecture ? "#f1f3f5" : "#1d2430";
-  const base = { margin: { l: 60, r: 12, t: lecture ? 60 : 48, b: lecture ? 64 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
-    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 20 : 12 },
+  const base = { margin: { l: lecture ? 76 : 60, r: 12, t: lecture ? 64 : 48, b: lecture ? 70 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
+    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 24 : 12 },
     // the legend at the figure's foot (container coordinates): plotly then makes room for it
     // under the axis title, which a legend placed below the plot area (paper y < 0) would cover
     legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0 } };
   // titles of one short line: plotly clips a title longer than its plot, and a second line too
-  const title = (text) => ({ text, font: { size: lecture ? 22 : 14 }, x: 0.02, xanchor: "left" });
+  const title = (text) => ({ text, font: { size: lecture ? 24 : 14 }, x: 0.02, xanchor: "left" });
   const top = () => base.margin;
   const span = t.slice(i, j + 1);
   const traces = Object.entries(run.work.non_conservative).map(([k, w]) => ({
@@ -93,7 +99,7 @@ export function showWork(run, { lecture = false } = {}) {
     const r = Math.max(energy, 1e-12) * 0.1;
     Object.assign(yaxis, { range: [-r, r], autorange: false });
     annotations.push({ text: `W<sup>NC</sup> = ΔT + ΔV = 0 within rounding<br>(largest |value| ${largest.toExponential(1)} J)`, showarrow: false,
-      xref: "paper", yref: "paper", x: 0.5, y: 0.62, font: { size: lecture ? 22 : 14, color: ink } });
+      xref: "paper", yref: "paper", x: 0.5, y: 0.62, font: { size: lecture ? 24 : 14, color: ink } });
   }
   $("plot-work").dataset.rounding = rounding ? "1" : "0";
   const workTitle = driven ? "W of forces and drive (stacked), ΔT + ΔV"
@@ -113,6 +119,19 @@ export function showWork(run, { lecture = false } = {}) {
   $("plot-constraint").dataset.tension = tension ? "1" : "0";
   window.Plotly.react("plot-constraint", ctraces, { ...base, margin: top(constraintTitle), title: title(constraintTitle),
     xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
+}
+
+/** The table's box scrolls sideways when the table is wider (a phone in lecture mode): say so
+ * under it, and again whenever the box changes width. */
+function cueScrolling(table) {
+  const box = table.closest(".table-scroll");
+  if (!box) return;
+  const mark = () => box.classList.toggle("scrolls", box.scrollWidth > box.clientWidth + 1);
+  mark();
+  if (!box.dataset.watched) {
+    box.dataset.watched = "1";
+    new ResizeObserver(mark).observe(box);
+  }
 }
 
 export function watchWorkInputs(onChange) {
