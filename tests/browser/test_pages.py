@@ -308,7 +308,7 @@ def test_work_energy_table_balances_and_constraint_forces_are_plotted(server, pa
     wait_ready(page)
     p.wait_for_function("document.querySelector('#work-table').dataset.gap !== undefined")
     table = p.inner_text("#work-table")
-    assert "damper" in table and "force drive" in table and "balanced" in table
+    assert "damper" in table and "drive (applied force)" in table and "balanced" in table
     assert abs(float(p.get_attribute("#work-table", "data-gap"))) < 1e-5
     p.fill("#work-t1", "2")
     p.dispatch_event("#work-t1", "change")
