@@ -16,6 +16,13 @@ both trajectories (q, q̇, the positions and frame axes for drawing), the time t
 (a stated rule), and the energy of each run measured with the TRUE E(q, q̇) = T + V, so an answer
 that creates or destroys energy says how much.
 
+Each run ends at the scene's stops, as a /simulate run does (mechanics/stops.py watches and
+locates them): the answer changes the dynamics, not the geometry, so a mass reaching the pulley
+ends the answer's motion as it ends the true one. Past a stop the model does not hold, so every
+comparison (parting, energies, the drawing) covers only the time both motions exist; an Atwood
+machine integrated 5 s past its pulley had its masses fly 80 m through it, and its "largest
+kinetic energy" came from there (instructor play-test).
+
 An answer that cannot be integrated (no q̈ in it, q̈ not linear, its q̈ undetermined at the
 initial state) is refused as an ExprError on ``answer``; one that blows up during the run is a
 result (``student.blew_up_at``), not an error.
@@ -30,16 +37,18 @@ from typing import Any
 
 import numpy as np
 import sympy as sp
-from scipy.integrate import DOP853
+from scipy.integrate import DOP853, solve_ivp
+from scipy.optimize import brentq
 
 from mechanics.answers import read_answer
 from mechanics.check import check, expected_quantity
 from mechanics.derive import Derivation
 from mechanics.expr import ExprError, to_latex
 from mechanics.model import T as t
-from mechanics.numeric import _MATH, _NUMPY, _args, _plain
+from mechanics.numeric import _MATH, _NUMPY, StopFunction, _args, _plain, compile_derivation
 from mechanics.spec import SpecError
 from mechanics.steps import partial
+from mechanics.stops import StopWatch, refuse_passed_stops, stopped_at_start
 
 PREDICTED = ("T", "V", "L", "Q", "eom", "accel")
 T_END, MAX_T_END = 5.0, 10.0
@@ -76,6 +85,7 @@ class Run:
     reached: float  # how far the stepping got
     blew_up_at: float | None = None
     why: str = ""  # why it stopped early, in words
+    stopped_at: float | None = None  # when it reached one of the scene's stops (why: its message)
 
 
 def equations(d: Derivation, quantity: str, given: sp.Expr, j: int | None) -> list[sp.Expr]:
@@ -172,19 +182,72 @@ def _rhs(fn: Any, n: int, params: list[float]) -> Any:
     return rhs
 
 
-def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: float) -> Run:
+class _Watched:
+    """One model as mechanics/stops.py sees a scene (its stop functions, n, rhs(params), and the
+    derivation their fields are named in), so the answer's model is watched, and its stops
+    located, by the very code that ends a /simulate run."""
+
+    def __init__(self, d: Derivation, fn: Any, n: int, stops: list[StopFunction]) -> None:
+        self.derivation, self.fn, self.n, self.stops = d, fn, n, stops
+
+    def rhs(self, params: list[float]) -> Any:
+        inner = _rhs(self.fn, self.n, params)
+
+        def rhs(time_: float, y: np.ndarray) -> np.ndarray:
+            try:
+                return inner(time_, y)
+            except _Stop as stop:  # stops.py gives up on a state where ArithmeticError is raised
+                raise ArithmeticError(stop.why) from None
+
+        return rhs
+
+
+def scene_stops(d: Derivation) -> tuple[list[StopFunction], list[StopFunction]]:
+    """The stops watched on the true run, and on the answer's: the same surfaces, less a
+    string's tension (Newton's tension along the TRUE motion says nothing about where the
+    answer's string would slacken)."""
+    if not d.model.stops:
+        return [], []
+    c = compile_derivation(d)
+    stops = c.stops
+    return stops, [s for s, info in zip(stops, c.stop_specs, strict=True) if info.tension is None]
+
+
+def integrate(
+    fn: Any,
+    n: int,
+    y0: list[float],
+    params: list[float],
+    t_end: float,
+    watched: _Watched | None = None,
+    until: float | None = None,
+) -> Run:
     """DOP853 step by step, sampled on a uniform grid; stops at a blow-up, a singular q̈, the
-    step cap or the wall-time cap, keeping what it has. _Stop when it cannot start at all."""
+    step cap or the wall-time cap, keeping what it has. With ``watched``, it ends at the first
+    of the scene's stops, its last sample the located state there (``stopped_at``); ``until``
+    ends it sooner (where the true run ended), its last sample the state then. _Stop when it
+    cannot start at all."""
     samples = min(MAX_SAMPLES, int(t_end * SAMPLES_PER_SECOND) + 1)
     grid = np.linspace(0.0, t_end, samples)
     rhs = _rhs(fn, n, params)
     out = np.empty((samples, 2 * n))
     out[0] = y0
-    rhs(0.0, np.asarray(y0, dtype=float))  # a model singular at the start is refused by the caller
-    solver = DOP853(rhs, 0.0, np.asarray(y0, dtype=float), t_end, rtol=RTOL, atol=ATOL)
-    k, steps, deadline = 1, 0, time.monotonic() + RUN_SECONDS
+    start = np.asarray(y0, dtype=float)
+    rhs(0.0, start)  # a model singular at the start is refused by the caller
     run = Run(grid, out, 0.0)
+    watch = None
+    if watched is not None and watched.stops:
+        at_start = stopped_at_start(watched, params, start, t_end)
+        if at_start is not None:
+            return _stopped(run, 1, at_start, 0.0, start)
+        watch = StopWatch(watched, params, start)
+    bound = t_end if until is None else min(until, t_end)
+    if not bound > 0:
+        return _cut(run, 1, 0.0, start)
+    solver = DOP853(rhs, 0.0, start, bound, rtol=RTOL, atol=ATOL)
+    k, steps, deadline = 1, 0, time.monotonic() + RUN_SECONDS
     while solver.status == "running":
+        t_old = solver.t
         try:
             solver.step()
         except _Stop as stop:
@@ -196,6 +259,12 @@ def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: floa
         if not np.all(np.isfinite(solver.y)) or np.max(np.abs(solver.y)) > BLOW_UP:
             run.blew_up_at, run.why = float(solver.t), f"|q| or |q̇| passed {BLOW_UP:g}"
         dense = solver.dense_output()
+        if run.blew_up_at is None and watch is not None and watch(solver.t, solver.y):
+            stop, t_stop, y_stop = _located(watch, watched, params, dense, t_old)
+            while k < samples and grid[k] < t_stop and grid[k] <= solver.t:
+                out[k] = dense(grid[k])
+                k += 1
+            return _stopped(run, k, stop, t_stop, y_stop)
         while k < samples and grid[k] <= solver.t:
             out[k] = dense(grid[k])
             k += 1
@@ -211,8 +280,65 @@ def integrate(fn: Any, n: int, y0: list[float], params: list[float], t_end: floa
             break
     finite = np.all(np.isfinite(out[:k]), axis=1)
     k = int(np.argmin(finite)) if not finite.all() else k
+    if solver.status == "finished" and bound < t_end and finite.all():
+        return _cut(run, k, bound, solver.y)
     run.t, run.y = grid[:k], out[:k]
     return run
+
+
+def _located(
+    watch: StopWatch, watched: _Watched, params: list[float], dense: Any, t_old: float
+) -> tuple[StopFunction, float, np.ndarray]:
+    """Where the stop the watch saw is reached: a crossing within the last step is the root of
+    the stop's value along that step's dense output (as scipy's event location finds it); a
+    creep, a bounce or a value turning undefined go to the watch's own secant (mechanics/stops.py).
+    """
+    i, t0, _, t1, _, how = watch.hit
+    stop, n = watched.stops[i], watched.n
+
+    def value(s: float) -> float:
+        y = dense(s)
+        with np.errstate(all="ignore"):
+            return float(np.asarray(stop.value(s, *y[:n], *y[n:], *params)[0]))
+
+    if how == "crossed" and t0 == t_old:
+        before, after = value(t0), value(t1)
+        if math.isfinite(before) and math.isfinite(after) and before * after <= 0 < before**2:
+            t_stop = t1 if after == 0 else brentq(value, t0, t1, xtol=1e-13, rtol=1e-13)
+            return stop, float(t_stop), dense(t_stop)
+    return watch.secant(params)
+
+
+def _cut(run: Run, k: int, t: float, state: np.ndarray) -> Run:
+    """The run's first k samples before t, then the state at t (a run's end off the grid)."""
+    k = int(np.searchsorted(run.t[:k], t, "left"))
+    return Run(
+        np.append(run.t[:k], t),
+        np.vstack([run.y[:k], state]),
+        run.reached if run.reached > t else t,
+        run.blew_up_at,
+        run.why,
+        run.stopped_at,
+    )
+
+
+def _stopped(run: Run, k: int, stop: StopFunction, t: float, state: np.ndarray) -> Run:
+    """The run ended at a stop: cut there, the stop's message its reason."""
+    out = _cut(run, k, t, state)
+    out.reached, out.stopped_at, out.why = t, t, stop.message
+    return out
+
+
+def _state_at(fn: Any, n: int, params: list[float], run: Run, t: float) -> np.ndarray:
+    """The run's state at time t within it, integrated from the last sample before (where the
+    run is smooth: it has not reached a stop yet)."""
+    j = int(np.searchsorted(run.t, t, "right")) - 1
+    if run.t[j] == t:
+        return run.y[j]
+    sol = solve_ivp(
+        _rhs(fn, n, params), (run.t[j], t), run.y[j], method="DOP853", rtol=RTOL, atol=ATOL
+    )
+    return sol.y[:, -1]
 
 
 def initial_state(
@@ -451,20 +577,36 @@ def predict(
         )
     student_fn = compile_model(d, equations(d, quantity, given, j))
     true_fn = compile_model(d, true_rows)
+    true_stops, student_stops = scene_stops(d)
+    true_model = _Watched(d, true_fn, n, true_stops)
+    if true_stops:  # as /simulate: a start past a stop is refused, naming the initial state
+        refuse_passed_stops(true_model, params, np.asarray(y0, dtype=float))
     try:
-        true = integrate(true_fn, n, y0, params, t_end)
+        true = integrate(true_fn, n, y0, params, t_end, true_model)
     except _Stop as stop:
         raise SpecError(
             cannot_start(d, true_fn, parameters or {}, initial or {}, stop.why)
         ) from None
-    try:
-        student = integrate(student_fn, n, y0, params, t_end)
+    try:  # not past the true run's stop: there is nothing to compare it with
+        student = integrate(
+            student_fn,
+            n,
+            y0,
+            params,
+            t_end,
+            _Watched(d, student_fn, n, student_stops),
+            until=true.stopped_at,
+        )
     except _Stop as stop:
         raise ExprError(
             f"your answer gives no motion from the initial state: {stop.why}", field="answer"
         ) from None
     if student.blew_up_at is not None and student.reached == 0:
         raise ExprError(f"your answer's motion blows up at once: {student.why}", field="answer")
+    if _ends_first(student, true.t[-1]):
+        # the answer's motion ended first: the true one is shown and compared up to then only
+        state = _state_at(true_fn, n, params, true, student.stopped_at)
+        true = _cut(true, len(true.t), student.stopped_at, state)
     drawing = _Drawing(d)
     parted_at, rule = parting(drawing, true, student, params)
     kinetic, potential = drawing.at(drawing.energy, true, params)
@@ -520,8 +662,8 @@ def _summary(
     t_end: float | None = None,
 ) -> str:
     """One sentence a student reads first (math as $…$). When a run stopped before t_end
-    without blowing up (too many steps), the comparison covers only the time both reached,
-    and the sentence says so: "the same motion" over 0.45 s is not over 5 s."""
+    without blowing up (a stop of the scene, too many steps), the comparison covers only the
+    time both reached, and the sentence says so: "the same motion" over 0.45 s is not over 5 s."""
     parts = []
     if student.blew_up_at is not None:
         parts.append(
@@ -543,8 +685,8 @@ def _summary(
             f"measured with the true energy, your model's energy swings by up to {_pct(most)} "
             f"of the true motion's largest kinetic energy ({energy['energy_scale']:.3g})"
         )
-    window = ""
-    if true is not None and t_end is not None and student.blew_up_at is None:
+    window = _ends(true, student) if true is not None else ""
+    if not window and true is not None and t_end is not None and student.blew_up_at is None:
         cut = [(r.reached, whose, r.why) for r, whose in ((true, "the true"), (student, "your"))]
         reached, whose, why = min(cut, key=lambda c: c[0])
         if reached < t_end * (1 - 1e-9):
@@ -558,3 +700,29 @@ def _summary(
     text = text[0].upper() + text[1:]
     cause = f" The cause: {blamed[0].lower() + blamed[1:]}" if blamed else ""
     return f"{text}.{window}{cause}"
+
+
+def _ends_first(student: Run, end: float | None) -> bool:
+    """Did the answer's motion end at a stop before `end` (the true run's), by more than the
+    round-off of locating the same stop on the same motion twice?"""
+    if student.stopped_at is None:
+        return False
+    return end is None or student.stopped_at < end - 1e-9 * max(1.0, end)
+
+
+def _ends(true: Run, student: Run) -> str:
+    """When and why a motion ended at one of the scene's stops, and so where the comparison
+    ends ("" when neither did)."""
+    if _ends_first(student, true.stopped_at):
+        text = f" Your answer's motion ends at t = {student.stopped_at:.2f} s ({student.why})"
+        if true.stopped_at is not None:
+            text += f", before the true one, which ends at t = {true.stopped_at:.2f} s ({true.why})"
+        return f"{text}: the motions are compared up to t = {student.stopped_at:.2f} s only."
+    if true.stopped_at is None:
+        return ""
+    text = f" The true motion ends at t = {true.stopped_at:.2f} s ({true.why})"
+    if student.stopped_at is not None:  # at the same moment, to round-off: the same stop
+        text += ", and so does yours"
+    if student.blew_up_at is not None:  # the comparison ended sooner, as the sentence says
+        return f"{text}."
+    return f"{text}: the motions are compared up to then only."
