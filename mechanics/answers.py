@@ -201,13 +201,14 @@ def answer_names(d: Derivation) -> dict[str, sp.Expr]:
 
 
 def read_answer(
-    d: Derivation, quantity: str, answer: str, j: int | None
+    d: Derivation, quantity: str, answer: str, j: int | None, *, exact_decimals: bool = False
 ) -> tuple[sp.Expr, sp.Expr]:
     """The answer as one expression, and the part of it typed right of '=' (zero without one).
 
     An equation of motion may be written `lhs = rhs` (read as lhs − rhs = 0); q̈ may be written
     `theta_ddot = ...`. Every ExprError points at the character the student typed, not at the
-    rewritten text the parser saw.
+    rewritten text the parser saw. ``exact_decimals``: each decimal is the exact value of its
+    text (the checker judges numbers as typed: 1.9999999999 is not 2).
     """
     model = d.model
     try:
@@ -222,7 +223,13 @@ def read_answer(
         try:
             # the typed answer is at most MAX_LENGTH characters, so at most that many tokens;
             # its rewrite spaces them out and spells them (θ -> theta, θθ -> theta * theta)
-            return parse(text[start:end], names, field="answer", max_length=10 * MAX_LENGTH)
+            return parse(
+                text[start:end],
+                names,
+                field="answer",
+                max_length=10 * MAX_LENGTH,
+                exact_decimals=exact_decimals,
+            )
         except ExprError as exc:
             at = None if exc.position is None else where[min(start + exc.position, len(text))]
             message = exc.message

@@ -13,7 +13,9 @@ from __future__ import annotations
 import cmath
 import math
 import random
+import re
 from dataclasses import dataclass, field
+from decimal import Decimal, localcontext
 from typing import Any
 
 import sympy as sp
@@ -22,7 +24,7 @@ from sympy.simplify.fu import TR5
 from mechanics import units
 from mechanics.answers import read_answer
 from mechanics.derive import Derivation
-from mechanics.expr import to_latex
+from mechanics.expr import to_latex as _latex_of
 from mechanics.model import T as t
 from mechanics.spec import SpecError
 from mechanics.steps import _symbols_for, partial, tidy
@@ -50,6 +52,10 @@ SIMPLIFY_OPS = 60
 MAX_SIGN_CASES = 3
 #: expand_trig of sin(n θ) is a polynomial of degree n: past this n the trig stays opaque.
 MAX_TRIG_MULTIPLE = 8
+#: A number typed within this relative distance of a simple one (a fraction with a denominator
+#: up to NEAR_MISS_DENOMINATOR) is a near miss of it: 1.9999999999 of 2, 0.49999999999 of 1/2.
+NEAR_MISS = 1e-6
+NEAR_MISS_DENOMINATOR = 1000
 
 
 #: How a verdict that no proof could settle begins (`Verdict.confirmed`).
@@ -127,9 +133,10 @@ def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
     small = ops <= PROOF_OPS and _expansion_size(expr, MAX_NORMAL_TERMS) <= MAX_NORMAL_TERMS
     to_sym, _ = _symbols_for(model)
     e = expr.xreplace(to_sym)
-    floats = {f: sp.nsimplify(f, rational=True) for f in e.atoms(sp.Float)}
-    e = e.xreplace(floats)  # 1e-12 is 1/10**12 exactly: the student's decimal, not binary's
-    cases = _sign_cases(e)
+    # a Float left (a spec's 15-digit parameter) is the exact decimal it prints as: 1e-12 is
+    # 1/10**12, 1.9999999999 is not 2 (nsimplify would snap it to the nearest simple number)
+    e = e.xreplace({f: sp.Rational(str(f)) for f in e.atoms(sp.Float)})
+    cases = _sign_cases(e, _positive_in_domain(model))
     if cases is None:
         return None
     results = [_zero_by_algebra(c, small) for c in cases]
@@ -165,10 +172,36 @@ def constant_proof(expr: sp.Expr, model: Any) -> bool | None:
     return False if False in results else None
 
 
-def _sign_cases(e: sp.Expr) -> list[sp.Expr] | None:
+def _positive_in_domain(model: Any) -> tuple[sp.Expr, ...]:
+    """What the scene's model keeps positive wherever it holds, as plain symbols: the value of
+    each unguarded stop a run ends at (L0 + x for a spring that may not reach its anchor; a
+    Piecewise's branch where the scene's parameters select it). |L0 + x| is L0 + x there, and
+    an identity needs to hold only there."""
+    cached = getattr(model, "_positive_in_domain", None)
+    if cached is not None:
+        return cached
+    to_sym, _ = _symbols_for(model)
+    values = {
+        sym: sp.Rational(str(model.spec.parameters[name])) for name, sym in model.params.items()
+    }
+    out = []
+    for value, guard in _domain_limits(model):
+        if guard is not None:
+            continue
+        if isinstance(value, sp.Piecewise):
+            branch, condition = value.args[0]
+            if condition.xreplace(values) is not sp.true:
+                continue
+            value = branch
+        out.append(value.xreplace(to_sym))
+    model._positive_in_domain = tuple(out)
+    return model._positive_in_domain
+
+
+def _sign_cases(e: sp.Expr, positive: tuple[sp.Expr, ...] = ()) -> list[sp.Expr] | None:
     """``e`` with each |a| and sign(a) replaced for a ≥ 0 and for a < 0 (a at a pole of sign,
-    a = 0, is one state among infinitely many and does not decide an identity). None past
-    MAX_SIGN_CASES of them."""
+    a = 0, is one state among infinitely many and does not decide an identity); only a > 0
+    where a is kept ``positive`` by the scene's domain. None past MAX_SIGN_CASES of them."""
     inner = sorted(e.atoms(sp.Abs, sp.sign), key=sp.default_sort_key)
     arguments = list(dict.fromkeys(f.args[0] for f in inner))
     if len(arguments) > MAX_SIGN_CASES:
@@ -177,7 +210,8 @@ def _sign_cases(e: sp.Expr) -> list[sp.Expr] | None:
     for a in arguments:
         mine = [f for f in inner if f.args[0] == a]
         split = []
-        for s in (1, -1):
+        signs = (1,) if a in positive else (-1,) if -a in positive else (1, -1)
+        for s in signs:
             resolved = {f: s * a if isinstance(f, sp.Abs) else sp.Integer(s) for f in mine}
             split += [c.xreplace(resolved) for c in cases]
         cases = split
@@ -311,7 +345,7 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
             )
         j = model.coordinate_names.index(coordinate)
     expected = expected_quantity(d, quantity, j)
-    given, moved = read_answer(d, quantity, answer, j)
+    given, moved = read_answer(d, quantity, answer, j, exact_decimals=True)
     shown = to_latex(given)
     if quantity == "eom":  # an equation reads as one: lhs = rhs as typed, or = 0
         shown = f"{to_latex(given + moved)} = {to_latex(moved)}"
@@ -332,6 +366,41 @@ def _latex(d: Derivation, quantity: str, j: int | None) -> str:
     return to_latex(expected_quantity(d, quantity, j))
 
 
+#: A rational whose denominator is past this (and a power of 2 and 5 only) came from a decimal
+#: the student typed, and is shown as one: 10^{-300}, not a fraction with 300 zeros.
+DECIMAL_DENOMINATOR = 10**6
+
+
+def to_latex(expr: sp.Expr) -> str:
+    """LaTeX of an answer with its decimals shown as decimals: the checker reads 1.9999999999
+    exactly (19999999999/10¹⁰), and the student should read back what they typed."""
+    shown = {r: _as_decimal(r) for r in expr.atoms(sp.Rational) if _typed_decimal(r)}
+    if not shown:
+        return _latex_of(expr)
+    return _POWER_OF_TEN.sub("10^", _latex_of(expr.xreplace(shown)))  # 10⁻³⁰⁰, not 1.0·10⁻³⁰⁰
+
+
+_POWER_OF_TEN = re.compile(r"(?<![\d.])1\.0 \\cdot 10\^")
+
+
+def _typed_decimal(r: sp.Rational) -> bool:
+    q = int(r.q)
+    if q <= DECIMAL_DENOMINATOR:
+        return False
+    for prime in (2, 5):
+        while q % prime == 0:
+            q //= prime
+    return q == 1
+
+
+def _as_decimal(r: sp.Rational) -> sp.Float:
+    """The exact decimal of a rational p/(2ᵃ5ᵇ), as a Float holding all of its digits."""
+    with localcontext() as context:
+        context.prec = len(str(r.p)) + len(str(r.q)) + 2
+        decimal = (Decimal(int(r.p)) / Decimal(int(r.q))).normalize()
+    return sp.Float(str(decimal), max(1, len(decimal.as_tuple().digits)))
+
+
 def inline(expr: sp.Expr) -> str:
     """Inline math for a feedback sentence: `$\\frac{g}{l} \\sin\\theta$` (the page renders it)."""
     return f"${to_latex(expr)}$"
@@ -343,6 +412,33 @@ def _as_written(term: sp.Expr) -> str:
     if sp.count_ops(term) > 40:
         return "you wrote as a long expression" if not term.is_Pow else "that is a power of a sum"
     return inline(term)
+
+
+#: Random draws allowed per sampled state to find one inside the scene's domain.
+DOMAIN_TRIES = 20
+
+
+def _domain_limits(model: Any) -> list[tuple[sp.Expr, sp.Expr | None]]:
+    """Where the scene's model holds, as its runs see it: each stop that ends a run when its
+    value falls to 0 (a spring at its anchor, a position's domain end, a coordinate declared
+    positive, a declared `when`), with its guard (`only_if`). A state where one of them is ≤ 0
+    is one no run reaches, and an answer may differ from the derived one there (|L0 + x| for
+    L0 + x): the checker samples, and claims, only inside. Stops on a tension (Newton's method
+    at run time) and sign-change stops (friction) bound no region and are left out."""
+    return [
+        (stop.when, stop.only_if)
+        for stop in model.stops
+        if stop.when is not None and stop.crossing == "falls"
+    ]
+
+
+def _number_at(expr: sp.Expr, state: dict) -> float:
+    """``expr`` at a state, as a float; NaN where it has no real value."""
+    try:
+        value = complex(expr.xreplace(state).evalf(20))
+    except (TypeError, ValueError, ArithmeticError):
+        return math.nan
+    return value.real if abs(value.imag) <= 1e-12 * max(1.0, abs(value.real)) else math.nan
 
 
 class _Judge:
@@ -363,11 +459,34 @@ class _Judge:
         self.reference = expected
         self.scale: sp.Expr = sp.S.One  # the student's scaling of an equation of motion
         rng = random.Random(0)
-        self.states = [self._state(rng) for _ in range(SAMPLES)]
+        self.limits = _domain_limits(self.m)
+        self.states = [self._inside_state(rng, {}) for _ in range(SAMPLES)]
         # The same motion states at one set of parameters: for "constant" and "multiple of",
         # which may depend on the parameters but not on q, q̇, q̈ or t.
         fixed = {sym: self.states[0][sym] for sym in self.m.params.values()}
-        self.motion_states = [{**s, **fixed} for s in self.states]
+        self.motion_states = [
+            s if self._inside({**s, **fixed}) else self._inside_state(rng, fixed)
+            for s in self.states
+        ]
+        self.motion_states = [{**s, **fixed} for s in self.motion_states]
+
+    def _inside_state(self, rng: random.Random, fixed: dict) -> dict:
+        """A random state where the scene's model holds (see `_domain_limits`), the parameters
+        ``fixed`` kept; the last one drawn if none of a few is (no state is refused outright)."""
+        for _ in range(DOMAIN_TRIES):
+            state = {**self._state(rng), **fixed}
+            if self._inside(state):
+                break
+        return state
+
+    def _inside(self, state: dict) -> bool:
+        """Does the model hold in ``state``: every limit's value > 0 where its guard applies?"""
+        for value, guard in self.limits:
+            if guard is not None and _number_at(guard, state) < 0:
+                continue  # the stop does not apply here
+            if not _number_at(value, state) > 0:  # NaN too: undefined is outside
+                return False
+        return True
 
     def _state(self, rng: random.Random) -> dict:
         m = self.m
@@ -422,7 +541,31 @@ class _Judge:
         if q in ("V", "L") and self._constant(self.given - self.expected):
             self._settle(verdict, self.given - self.expected, constant=True)
             return
+        if q == "L" and self._time_only(self.given - self.expected, fb):
+            return
         self._diagnose(self.given, self.expected, fb)
+
+    def _time_only(self, diff: sp.Expr, fb: list[str]) -> bool:
+        """An L that differs from T − V by a function of t alone (a driven support's
+        −m g A sin ωt left out): not T − V as asked, but no equation of motion changes, as for an
+        added constant; the feedback says so instead of 'Missing term'. Proved: ∂/∂q and ∂/∂q̇
+        of the difference are zero (the samples found it not constant: it changes with t)."""
+        if not diff.has(t):
+            return False
+        to_sym, _ = _symbols_for(self.m)
+        plain = diff.xreplace(to_sym)
+        for q, qd in zip(self.m.q, self.m.qd, strict=True):
+            for sym in (to_sym[q], to_sym[qd]):
+                if plain.has(sym) and zero_proof(plain.diff(sym), self.m) is not True:
+                    return False
+        shown = tidy(-diff, self.m)
+        term = f", {inline(shown)}," if sp.count_ops(shown) <= 30 else ""
+        fb.append(
+            f"Your L falls short of T − V by a function of t only{term} so no equation of "
+            "motion changes (∂/∂q and d/dt ∂/∂q̇ of it are 0, as of an added constant); but L "
+            "is T − V itself, and that term belongs in it."
+        )
+        return True
 
     def _settle(self, verdict: Verdict, diff: sp.Expr, constant: bool = False) -> None:
         """The samples found no difference (or a constant one): "Correct" only on a proof.
@@ -443,8 +586,14 @@ class _Judge:
             return
         if proof is None:
             fb.append(
-                self._apart_elsewhere(diff, constant=constant) or self._unconfirmed(diff, constant)
+                self._near_miss()
+                or self._apart_elsewhere(diff, constant=constant)
+                or self._unconfirmed(diff, constant)
             )
+            return
+        undefined = self._undefined_at_parameters(self.given)
+        if undefined:
+            fb.append(undefined)
             return
         verdict.correct = True
         fb.append(
@@ -563,7 +712,8 @@ class _Judge:
             state = dict(state)
             for name, q in zip(self.m.coordinate_names, self.m.q, strict=True):
                 state[q] = sp.Float(rng.uniform(0.2 if name in positive else -3.1, 3.1), 30)
-            wide.append(state)
+            if self._inside(state):  # past a stop no run goes: nothing to claim there
+                wide.append(state)
         values = self._values_at(diff, wide)
         base = self._values_at(diff, self.motion_states[:1])[0] if constant else 0
         for state, v in zip(wide, values, strict=True):
@@ -620,9 +770,14 @@ class _Judge:
         if proof is None:
             claim = "is the derived equation, scaled,"
             fb.append(
-                self._apart_elsewhere(given - ratio * expected, motion_only=True, claim=claim)
+                self._near_miss()
+                or self._apart_elsewhere(given - ratio * expected, motion_only=True, claim=claim)
                 or self._unconfirmed(given - ratio * expected, claim=claim)
             )
+            return
+        degenerate = self._degenerate_factor(given, expected) if proof else ""
+        if degenerate:
+            fb.append(degenerate)
             return
         if proof:
             verdict.correct = True
@@ -678,6 +833,161 @@ class _Judge:
             )
             return
 
+    def _parameter_values(self) -> dict[sp.Symbol, sp.Rational]:
+        """The scene's own parameter values, exactly as their decimals read (9.81 is 981/100)."""
+        return {
+            sym: sp.Rational(str(self.m.spec.parameters[name]))
+            for name, sym in self.m.params.items()
+        }
+
+    def _at_parameters(self, names: set[sp.Symbol]) -> str:
+        """'m = 1, l = 1': the scene's values of the parameters named."""
+        return ", ".join(
+            f"{name} = {self.m.spec.parameters[name]:g}"
+            for name, sym in self.m.params.items()
+            if sym in names
+        )
+
+    def _undefined_at_parameters(self, expr: sp.Expr) -> str:
+        """A sentence when ``expr`` has no value at the scene's own parameter values (it divides
+        by m − 1 and m = 1): the samples vary the parameters and never land there, yet that is
+        where the scene is run. "" when it has one."""
+        values = self._parameter_values()
+        undefined = (sp.zoo, sp.nan, sp.oo, -sp.oo)
+        if not expr.xreplace(values).has(*undefined) or self.expected.xreplace(values).has(
+            *undefined
+        ):
+            return ""  # defined there, or the scene's own result is not (not the answer's doing)
+        poles = []
+        for factor in sp.Mul.make_args(sp.factor_terms(sp.together(expr))):
+            base, exponent = factor.as_base_exp()
+            if exponent.is_negative and base.xreplace(values) == 0:
+                poles.append(base)
+        named = " and ".join(inline(p) for p in poles) or "something"
+        used = set().union(*(p.free_symbols for p in poles)) if poles else expr.free_symbols
+        return (
+            f"Your answer divides by {named}, which is 0 at the scene's values "
+            f"({self._at_parameters(used)}): there it has no value at all. It may not divide by "
+            "anything that vanishes at the parameters the scene is run with."
+        )
+
+    def _degenerate_factor(self, given: sp.Expr, expected: sp.Expr) -> str:
+        """A sentence when the student's equation, proved a constant multiple c of the derived
+        one, has c = 0 or c = ∞ at the scene's own parameter values (× (m − 1) with m = 1): there
+        it says 0 = 0, or nothing, and determines no acceleration (a prediction refuses it for
+        the same reason). The samples vary the parameters and never land there. "" otherwise."""
+        qdd = self.m.qdd[self.j]
+        derived = partial(expected, qdd, self.m)
+        factor = partial(given, qdd, self.m) / derived
+        values = self._parameter_values()
+        # proved free of the motion: any one state's q, q̇, t serve for what may be left
+        motion = {k: v for k, v in self.states[0].items() if k not in values.keys()}
+        own = derived.xreplace(values).xreplace(motion)
+        if own.has(sp.zoo, sp.nan, sp.oo, -sp.oo) or own.is_zero is not False:
+            return ""  # the derived equation itself degenerates there: not the answer's doing
+        at = factor.xreplace(values).xreplace(motion)
+        if not at.has(sp.zoo, sp.nan, sp.oo, -sp.oo) and at.is_zero is not True:
+            try:
+                size = abs(complex(at.evalf(50)))
+            except (TypeError, ValueError, ArithmeticError):
+                size = math.nan
+            if math.isfinite(size) and size > 1e-30:
+                return ""
+        zeros, poles = [], []
+        for form in (factor, sp.factor_terms(sp.together(factor))):  # as written, then factored
+            for part in sp.Mul.make_args(form):
+                base, exponent = part.as_base_exp()
+                if base.is_number or base.xreplace(values).xreplace(motion) != 0:
+                    continue
+                (poles if exponent.is_negative else zeros).append(base)
+            if zeros or poles:
+                break
+        if zeros and poles:
+            how = (
+                f"multiplied by {', '.join(map(inline, zeros))} and divided by "
+                f"{', '.join(map(inline, poles))}, all 0"
+            )
+            says = "it reads 0/0, no equation at all"
+        elif poles:
+            how = f"divided by {' and '.join(map(inline, poles))}, which is 0"
+            says = "it divides by zero and has no value"
+        else:
+            zeros = zeros or [factor]
+            how = f"multiplied by {' and '.join(map(inline, zeros))}, which is 0"
+            says = "it says 0 = 0"
+        used = set().union(*(z.free_symbols for z in (*zeros, *poles))) & set(values)
+        where = self._at_parameters(used) or self._at_parameters(set(values))
+        return (
+            f"Your equation is the derived one {how} at the scene's values ({where}): there "
+            f"{says}, and determines no {inline(qdd)}. Scale an equation of motion only by a "
+            "constant that is non-zero (and finite) at the scene's parameter values."
+        )
+
+    def _near_miss(self) -> str:
+        """A sentence when the answer is right but for a number a hair from a simple one
+        (1.9999999999 for 2, 0.49999999999 for 1/2): with those numbers it is provably right, and
+        as typed it is provably (or visibly, at 25 digits) not. Numbers are judged as typed, so
+        it is not correct; the student should read which number, and by how much. "" if none."""
+        given = self.given
+        snapped = {}
+        for r in given.atoms(sp.Rational):
+            if r.is_Integer or r.q <= NEAR_MISS_DENOMINATOR:
+                continue
+            simple = r.limit_denominator(NEAR_MISS_DENOMINATOR)
+            if simple != 0 and abs(r - simple) <= NEAR_MISS * abs(simple):
+                snapped[r] = simple
+        if not snapped:
+            return ""
+        candidate = given.xreplace(snapped)
+        if not self._provably_right(candidate) or not self._apart(given, candidate):
+            return ""
+        pairs = sorted(snapped.items(), key=lambda kv: sp.default_sort_key(kv[0]))[:3]
+        which = "; ".join(
+            f"{inline(r)} where {inline(s)} would do (they differ by {inline(abs(r - s))})"
+            for r, s in pairs
+        )
+        return (
+            f"Your answer is almost, but not exactly, right: it has {which}. With "
+            f"{'that number' if len(pairs) == 1 else 'those numbers'} it would be right; numbers "
+            "are judged exactly as typed. A number rounded, or typed with a slip?"
+        )
+
+    def _provably_right(self, candidate: sp.Expr) -> bool:
+        """Would ``candidate`` be marked correct (on a proof, as the quantity asks)?"""
+        if self.quantity == "eom":
+            return self._multiple_proof(candidate, self.expected) is True
+        diff = candidate - self.expected
+        if zero_proof(diff, self.m) is True:
+            return True
+        return self.quantity in ("V", "L") and constant_proof(diff, self.m) is True
+
+    def _apart(self, given: sp.Expr, candidate: sp.Expr) -> bool:
+        """Is ``given`` not ``candidate`` (or, for an equation, not a constant multiple of it)?
+        Proved, or seen at the 25-digit evaluation far above its rounding."""
+        motion = self.quantity == "eom"
+        if not motion:
+            diff = given - candidate
+            if zero_proof(diff, self.m) is False and (
+                self.quantity not in ("V", "L") or constant_proof(diff, self.m) is False
+            ):
+                return True
+        a, b = self.values(given, motion), self.values(candidate, motion)
+        pairs = [
+            (x, y) for x, y in zip(a, b, strict=True) if not (cmath.isnan(x) or cmath.isnan(y))
+        ]
+        if len(pairs) < 2:
+            return False
+        if motion or self.quantity in ("V", "L"):  # a constant factor, or a datum: may differ
+            if motion:
+                ratios = [x / y for x, y in pairs if abs(y) > 0]
+                return len(ratios) >= 2 and any(
+                    abs(r - ratios[0]) > 1e-18 * abs(ratios[0]) for r in ratios
+                )
+            gaps = [x - y for x, y in pairs]
+            scale = max(max(abs(x), abs(y)) for x, y in pairs)
+            return any(abs(g - gaps[0]) > 1e-18 * max(scale, 1e-300) for g in gaps)
+        return any(abs(x - y) > 1e-18 * max(abs(x), abs(y)) for x, y in pairs)
+
     def _multiple_proof(self, given: sp.Expr, expected: sp.Expr) -> bool | None:
         """Is the equation ``given`` the derived one times a constant (of the parameters)? The
         factor can only be the ratio of their q̈_j coefficients, c; proved when given − c·expected
@@ -708,6 +1018,10 @@ class _Judge:
 
     # -- what is wrong ---------------------------------------------------------------------
     def _diagnose(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:
+        near = self._near_miss()
+        if near:  # its terms would read as missing and extra, its units as mixed: neither is
+            fb.append(near)
+            return
         ratio = self._ratio(given, expected)
         # a fixed multiple of the derived result approximates nothing: the approximation is
         # looked for only when there is no one factor (and its proofs cost a second on a q̈)

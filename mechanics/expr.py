@@ -131,6 +131,30 @@ def _number(value: object, field: str, position: int | None = None) -> sp.Expr:
     return sp.Float(repr(value), 15)
 
 
+#: The most significant digits an exactly read decimal may have (`parse`'s ``exact_decimals``).
+MAX_EXACT_DIGITS = 100
+
+
+def _exact_number(literal: str, value: object, field: str, position: int | None) -> sp.Expr:
+    """A decimal literal as the exact Rational of its text (``1.9999999999`` is
+    19999999999/10¹⁰, ``1e-40`` is 10⁻⁴⁰), for a reader that judges what was typed: a 15-digit
+    Float rounds 1/2 + 10⁻⁴⁰ to 1/2 and makes a near miss an exact hit. The usual checks first
+    (finite as a double); past MAX_EXACT_DIGITS significant digits, or an exponent past a
+    double's range, the usual reading."""
+    number = _number(value, field, position)  # refuses what every reading refuses
+    try:
+        decimal = Decimal(literal.replace("_", ""))
+    except ArithmeticError:
+        return number
+    digits = decimal.normalize().as_tuple()
+    if len(digits.digits) > MAX_EXACT_DIGITS or not -330 <= decimal.adjusted() <= 308:
+        return number
+    if decimal == decimal.to_integral_value() and abs(decimal) >= 10**MAX_DIGITS:
+        return number  # 1e300 as an exact 10**300: what an integer literal may not write either
+    exact = Fraction(decimal)
+    return sp.Rational(exact.numerator, exact.denominator)
+
+
 def _magnitude(value: sp.Expr) -> float:
     """|value| of a closed-form number (complex ones too); inf when it is not a finite float."""
     try:
@@ -313,9 +337,15 @@ class _Builder:
     """Turns a checked syntax tree into sympy, bottom-up, refusing anything off the whitelist."""
 
     def __init__(
-        self, names: Mapping[str, sp.Expr], field: str, offset: int, smooth: bool = False
+        self,
+        names: Mapping[str, sp.Expr],
+        field: str,
+        offset: int,
+        smooth: bool = False,
+        source: str | None = None,
     ) -> None:
         self.names, self.field, self.offset, self.smooth = names, field, offset, smooth
+        self.source = source  # the text parsed, when decimals are read exactly from it
 
     def error(self, message: str, node: ast.AST | None = None) -> ExprError:
         col = getattr(node, "col_offset", None)
@@ -336,6 +366,9 @@ class _Builder:
                 raise self.error("complex numbers are not allowed", node)
             if node.value is Ellipsis:
                 raise self.error("'...' is not allowed", node)
+            if self.source is not None and isinstance(node.value, float):
+                literal = ast.get_source_segment(self.source, node) or repr(node.value)
+                return _exact_number(literal, node.value, self.field, self.at(node))
             return _number(node.value, self.field, self.at(node))
         if isinstance(node, ast.Name):
             return self.name(node)
@@ -517,17 +550,21 @@ def parse(
     field: str = "",
     smooth: bool = False,
     max_length: int = MAX_LENGTH,
+    exact_decimals: bool = False,
 ) -> sp.Expr:
     """The only way user text becomes sympy: every node is checked against the whitelist.
 
     ``smooth``: the expression is differentiated in time (a position, a frame's angle), so
     abs() and sign() of a coordinate are refused: their derivatives stay unevaluated in sympy
     and no later step can put numbers into them. ``max_length``: for a text a caller rewrote
-    from one it bounded itself (a student's answer, spaced out between its tokens)."""
+    from one it bounded itself (a student's answer, spaced out between its tokens).
+    ``exact_decimals``: every decimal literal is the exact Rational of its text (the answer
+    checker's reading: a number is judged as typed), not the module docstring's rule."""
     if isinstance(text, int | float) and not isinstance(text, bool):
         return _number(text, field)
     tree, offset = _tree(text, field, max_length)
-    result = _Builder(names, field, offset, smooth).build(tree)
+    source = text.strip().translate(_TO_SPACE) if exact_decimals else None
+    result = _Builder(names, field, offset, smooth, source).build(tree)
     if result.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise ExprError("not a finite number", field=field)
     return result
