@@ -579,9 +579,10 @@ def predict(
     true_fn = compile_model(d, true_rows)
     true_stops, student_stops = scene_stops(d)
     true_model = _Watched(d, true_fn, n, true_stops)
-    if true_stops:  # as /simulate: a start past a stop is refused, naming the initial state
-        refuse_passed_stops(true_model, params, np.asarray(y0, dtype=float))
-    try:
+    try:  # a start without inertia is named first: the stops' tensions are 0/0 there too
+        _rhs(true_fn, n, params)(0.0, np.asarray(y0, dtype=float))
+        if true_stops:  # as /simulate: a start past a stop is refused, naming the initial state
+            refuse_passed_stops(true_model, params, np.asarray(y0, dtype=float))
         true = integrate(true_fn, n, y0, params, t_end, true_model)
     except _Stop as stop:
         raise SpecError(
@@ -670,14 +671,14 @@ def _summary(
             f"your answer's motion blows up at t = {student.blew_up_at:.3g} s ({student.why})"
         )
     if parted_at is not None:
-        parts.append(f"it parts visibly from the true motion at t = {parted_at:.2f} s")
+        parts.append(f"it parts visibly from the true motion at t = {_seconds(parted_at)} s")
     change, most = energy["energy_change"], energy["energy_change_max"]
     if abs(change) >= 1e-3:
         verb = "creates" if change > 0 else "destroys"
         parts.append(
             f"measured with the true energy, your model {verb} energy: {_pct(abs(change))} of the "
             f"true motion's largest kinetic energy ({energy['energy_scale']:.3g}) "
-            f"in {energy['energy_until']:.2f} s"
+            f"in {_seconds(energy['energy_until'])} s"
             + (f" (up to {_pct(most)} along the way)" if most > 1.5 * abs(change) else "")
         )
     elif most >= 1e-3:
@@ -702,6 +703,12 @@ def _summary(
     return f"{text}.{window}{cause}"
 
 
+def _seconds(t: float) -> str:
+    """A time as the sentence prints it: 2 decimals, or 2 digits under 0.01 s (a run ended by a
+    stop after 3e-5 s read 'ends at t = 0.00 s … before the true one, which ends at 0.00 s')."""
+    return f"{t:.2f}" if t == 0 or t >= 0.01 else f"{t:.2g}"
+
+
 def _ends_first(student: Run, end: float | None) -> bool:
     """Did the answer's motion end at a stop before `end` (the true run's), by more than the
     round-off of locating the same stop on the same motion twice?"""
@@ -714,13 +721,17 @@ def _ends(true: Run, student: Run) -> str:
     """When and why a motion ended at one of the scene's stops, and so where the comparison
     ends ("" when neither did)."""
     if _ends_first(student, true.stopped_at):
-        text = f" Your answer's motion ends at t = {student.stopped_at:.2f} s ({student.why})"
+        text = f" Your answer's motion ends at t = {_seconds(student.stopped_at)} s ({student.why})"
         if true.stopped_at is not None:
-            text += f", before the true one, which ends at t = {true.stopped_at:.2f} s ({true.why})"
-        return f"{text}: the motions are compared up to t = {student.stopped_at:.2f} s only."
+            at = _seconds(true.stopped_at)
+            same = true.why == student.why  # the same stop: its message once
+            text += ", before the true one, which " + (
+                f"gets there at t = {at} s" if same else f"ends at t = {at} s ({true.why})"
+            )
+        return f"{text}: the motions are compared up to t = {_seconds(student.stopped_at)} s only."
     if true.stopped_at is None:
         return ""
-    text = f" The true motion ends at t = {true.stopped_at:.2f} s ({true.why})"
+    text = f" The true motion ends at t = {_seconds(true.stopped_at)} s ({true.why})"
     if student.stopped_at is not None:  # at the same moment, to round-off: the same stop
         text += ", and so does yours"
     if student.blew_up_at is not None:  # the comparison ended sooner, as the sentence says

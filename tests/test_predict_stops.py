@@ -168,7 +168,10 @@ def test_an_answer_whose_motion_stops_first_ends_the_comparison_there(client, an
     assert body["parted_at"] == pytest.approx(parting_time(a, a_answer, t_answer), abs=1e-9)
     summary = body["summary"]
     assert f"Your answer's motion ends at t = {t_answer:.2f} s ({who} reaches the pulley" in summary
-    assert f"the true one, which ends at t = {t_true:.2f} s ({true_who} reaches" in summary
+    if who == true_who:  # the same stop, named once
+        assert f"before the true one, which gets there at t = {t_true:.2f} s:" in summary
+    else:
+        assert f"the true one, which ends at t = {t_true:.2f} s ({true_who} reaches" in summary
     assert f"in {t_answer:.2f} s" in summary and "5.00 s" not in summary
 
 
@@ -205,6 +208,24 @@ def test_a_start_past_the_pulley_is_refused_and_one_at_it_ends_at_once(client):
     body = predict(client, "g (m1-m2)", initial={"x": AT_PULLEY["mass2"]})
     assert body["true"]["t"] == [0.0] and body["student"]["t"] == [0.0]
     assert "ends at t = 0.00 s" in body["summary"]
+
+
+def test_masses_of_zero_are_blamed_not_the_strings_tension(client):
+    """m₁ = m₂ = 0 leaves x without inertia: the 422 names the parameter, as without stops, not
+    the string's tension stop (0/0 there too, but no field the student wrote)."""
+    r = client.post(
+        "/api/v1/check/predict",
+        json={
+            "scene_id": "atwood_machine",
+            "quantity": "Q",
+            "coordinate": "x",
+            "answer": "g (m1-m2)",
+            "parameters": {"m1": 0, "m2": 0},
+        },
+    )
+    assert r.status_code == 422, r.text[:500]
+    (error,) = r.json()["detail"]
+    assert error["field"].startswith("parameters.m") and "inertia" in error["message"]
 
 
 def test_a_scene_without_stops_runs_to_t_end(client):
