@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 from sympy.physics.mechanics import Particle, RigidBody, inertia
@@ -115,6 +116,9 @@ class Model:
     #: Declared stops, then the implicit ones: a branched spring reaching its anchor, a positive
     #: coordinate reaching 0.
     stops: list[StopInfo] = field(default_factory=list)
+    #: Quantities a real system cannot have negative, as written (field path, what it is, value):
+    #: checked at the parameter values of every run by `physical_limit_errors`.
+    limits: list[tuple[str, str, Any]] = field(default_factory=list)
 
     @property
     def coordinate_names(self) -> list[str]:
@@ -269,6 +273,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
             P.set_vel(N, r.dt(N))
             points[name] = P
 
+    limits: list[tuple[str, str, Any]] = []
     bodies: list[BodyInfo] = []
     for i, b in enumerate(spec.bodies):
         mass = expr(b.mass, f"bodies[{i}].mass")
@@ -289,6 +294,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
                 inert["izx"],
             )
             info.frame, info.inertia = fr, dyadic
+            limits.append((f"bodies[{i}].inertia", f"{b.name}'s inertia", inert))
             info.sympy_body = RigidBody(b.name, points[b.name], fr, mass, (dyadic, points[b.name]))
         else:
             info.sympy_body = Particle(b.name, points[b.name], mass)
@@ -297,6 +303,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
     gravity = None
     if spec.gravity is not None:
         g = expr(spec.gravity.acceleration, "gravity.acceleration")
+        limits.append(("gravity.acceleration", "the magnitude of gravity", g))
         d = [sp.nsimplify(c) for c in spec.gravity.direction] + [0] * (
             3 - len(spec.gravity.direction)
         )
@@ -313,6 +320,8 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         l0 = expr(s.rest_length, f"springs[{i}].rest_length")
         d = positions[s.b] - positions[s.a]
         name = s.name or f"spring{i + 1}"
+        limits.append((f"springs[{i}].k", f"the stiffness of {name}", k))
+        limits.append((f"springs[{i}].rest_length", f"the rest length of {name}", l0))
         _has_length(d, f"springs[{i}].b")
         if l0.is_zero:  # ½ k d·d: smooth everywhere, no length to take a root of
             length, branch, sign = _length_of(d.dot(d))
@@ -334,6 +343,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         rel = positions[dmp.b].dt(N) - positions[dmp.a].dt(N)
         along = -c * rel.dot(d) / _tidy_square(d.dot(d)) * d
         name = dmp.name or f"damper{i + 1}"
+        limits.append((f"dampers[{i}].c", f"the damping coefficient of {name}", c))
         loads.append(Load(name, "damper", dmp.b, along))
         if dmp.a != "O":
             loads.append(Load(name, "damper", dmp.a, -along))
@@ -386,7 +396,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
                     kind="positive",
                 )
             )
-    return Model(
+    model = Model(
         spec=spec,
         q=q,
         qd=[qi.diff(T) for qi in q],
@@ -406,7 +416,105 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
         potentials=potentials,
         branches=chosen,
         stops=stops,
+        limits=limits,
     )
+    from mechanics.spec import SpecError
+
+    errors = physical_limit_errors(model, spec.parameters)
+    if errors:
+        raise SpecError(errors)
+    return model
+
+
+#: Relative size below which a negative principal moment or a triangle-inequality excess is
+#: rounding (m l²/12 written as a decimal), not a wrong inertia.
+INERTIA_ROUNDING = 1e-9
+
+
+def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[str, str]]:
+    """What no real system has, at these parameter values, each naming its field.
+
+    The per-parameter sign checks see only a parameter standing alone (k = "k"); written as a
+    number or an expression ("-5", "k - 3", "-k") a negative stiffness, damping coefficient,
+    rest length or gravity went through and the run pumped energy in with no warning. A central
+    inertia tensor must be positive semidefinite with principal moments obeying the triangle
+    inequality (I₁ + I₂ ≥ I₃: ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(z² + x²) dm). A value that
+    depends on the state or on t is left to the mass-matrix and run checks.
+    """
+    numbers = {model.params[k]: sp.Float(v) for k, v in values.items() if k in model.params}
+    errors: list[dict[str, str]] = []
+
+    def number(e: Any) -> float | None:
+        try:
+            return float(sp.sympify(e).xreplace(numbers))
+        except (TypeError, ValueError):
+            return None
+
+    for where, what, value in model.limits:
+        if isinstance(value, dict):
+            errors += _inertia_errors(where, what, {k: number(v) for k, v in value.items()})
+            continue
+        x = number(value)
+        if x is None or x >= 0:
+            continue
+        alone = str(value) if value in model.params.values() else None
+        hint = (
+            ": point gravity.direction the other way for gravity pointing up"
+            if where == "gravity.acceleration"
+            else ""
+        )
+        shown = "" if alone or value.is_number else f" ({to_plain(value)} at these parameters)"
+        errors.append(
+            {
+                "field": f"parameters.{alone}" if alone else where,
+                "message": f"must be ≥ 0: {what} is {x:g}{shown}{hint}",
+            }
+        )
+    return errors
+
+
+def _inertia_errors(where: str, what: str, entries: dict[str, float | None]) -> list[dict]:
+    """A central inertia tensor no mass distribution has: a negative moment (named by its entry),
+    a tensor that is not positive semidefinite, or principal moments breaking I₁ + I₂ ≥ I₃."""
+    if any(v is None for v in entries.values()):
+        return []
+    negative = [k for k in ("ixx", "iyy", "izz") if entries[k] < 0]
+    if negative:
+        return [
+            {
+                "field": f"{where}.{k}",
+                "message": f"must be ≥ 0: a moment of inertia is "
+                f"∫ r² dm, and {what} has {k} = {entries[k]:g}",
+            }
+            for k in negative
+        ]
+    e = entries
+    rows = (("ixx", "ixy", "izx"), ("ixy", "iyy", "iyz"), ("izx", "iyz", "izz"))
+    tensor = np.array([[e[k] for k in row] for row in rows])
+    if not np.all(np.isfinite(tensor)):
+        return []
+    low, mid, high = np.linalg.eigvalsh(tensor)
+    tol = INERTIA_ROUNDING * max(abs(high), 1e-300)
+    moments = ", ".join(f"{x:.4g}" for x in (low, mid, high))
+    if low < -tol:
+        return [
+            {
+                "field": where,
+                "message": f"{what} is not positive semidefinite: its principal moments are "
+                f"{moments}, and a moment of inertia about any axis is ∫ r² dm ≥ 0 (the "
+                "products ixy, iyz, izx are too large for the moments on the diagonal)",
+            }
+        ]
+    if high > low + mid + tol:
+        return [
+            {
+                "field": where,
+                "message": f"{what} has principal moments {moments}: no mass distribution has "
+                "these, since the largest may not exceed the sum of the other two "
+                "(I₁ + I₂ ≥ I₃; a thin rod or a flat disk reaches equality)",
+            }
+        ]
+    return []
 
 
 def _corner_only_if_stretched(branch: sp.Expr, rest_length: sp.Expr) -> sp.Expr:

@@ -19,6 +19,7 @@ from scipy.integrate import cumulative_simpson
 
 from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
+from mechanics.model import physical_limit_errors
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
     EXTREME_EXPONENT,
@@ -118,6 +119,8 @@ def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float]
     if errors:
         raise SpecError(errors)
     values = {**spec.parameters, **req.parameters}
+    if req.parameters:  # the spec's own values were checked when its model was built
+        errors += physical_limit_errors(c.derivation.model, values)
     init = {**spec.initial, **req.initial}
     for q in spec.positive_coordinates:
         if init.get(q, 0.0) <= 0:
