@@ -1368,6 +1368,8 @@ def _stability(
     idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12 * inertia]
     if not idx:
         return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
+    if at_rest is not None and _singular(full_M[np.ix_(idx, idx)], 1e-12):
+        idx = _off_the_pole(at_rest, full_M, q0, numbers, idx)
     K = K_.reshape(n, n)[np.ix_(idx, idx)]
     C = C_.reshape(n, n)[np.ix_(idx, idx)]
     M = full_M[np.ix_(idx, idx)]
@@ -1388,6 +1390,42 @@ def _stability(
     return verdict
 
 
+def _singular(M: np.ndarray, tol: float) -> bool:
+    """Is M singular relative to its own size (smallest singular value ≤ tol × largest)?"""
+    s = np.linalg.svd(M, compute_uv=False)
+    return not s.size or not np.all(np.isfinite(s)) or s[-1] <= tol * max(s[0], 1e-300)
+
+
+def _off_the_pole(at_rest, full_M, q0, numbers, idx) -> list[int]:
+    """The coordinates kept when M is singular at q0 without a vanishing row: Euler angles at
+    θ = 0, where φ and ψ turn about one axis (det M = I₃ (I₁ + m h²)² sin²θ). It is a pole of
+    the coordinates when M is singular there at other parameter values too and regular beside
+    it; then one coordinate per direction without inertia is dropped (the one that direction
+    moves most), as φ is at a sphere's pole. Otherwise ``idx`` is returned as it is, and a
+    singular M is the parameters' doing (m₂ = 1e265 beside m₁ = 1), refused as before."""
+    n = len(q0)
+    rng = np.random.default_rng(7)
+    others = list(rng.uniform(0.7, 1.4, len(numbers)))
+    nearby = list(np.asarray(q0, dtype=float) + rng.uniform(0.05, 0.1, n))
+    with np.errstate(all="ignore"):
+        try:
+            elsewhere = np.array(at_rest(*q0, *others)[0], dtype=float).reshape(n, n)
+            beside = np.array(at_rest(*nearby, *numbers)[0], dtype=float).reshape(n, n)
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return idx
+    if not _singular(elsewhere[np.ix_(idx, idx)], 1e-9) or _singular(beside, 1e-9):
+        return idx
+    M = full_M[np.ix_(idx, idx)]
+    _, s, vt = np.linalg.svd(M)
+    null = vt[s <= 1e-9 * s[0]]
+    import scipy.linalg
+
+    _, _, pivots = scipy.linalg.qr(null, pivoting=True)
+    dropped = {idx[k] for k in pivots[: len(null)]}
+    kept = [j for j in idx if j not in dropped]
+    return kept if kept and not _singular(full_M[np.ix_(kept, kept)], 1e-9) else idx
+
+
 def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> None:
     """q0 is a coordinate singularity: the rows of M of the coordinates in ``lost`` vanish here
     (φ at θ = 0 of a sphere), so the linearization above is in the others only, and one
@@ -1402,9 +1440,18 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     and the verdict says so rather than show a short list."""
     lost_names = ", ".join(m.coordinate_names[j] for j in lost)
     where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
+    inertia = float(np.max(np.abs(full_M), initial=0.0))
+    if all(np.max(np.abs(full_M[j])) <= 1e-12 * inertia for j in lost):
+        why = f"any {lost_names} names the same point: its row of M vanishes"
+    else:  # Euler angles at θ = 0: φ and ψ turn about one axis
+        why = (
+            f"M is singular here for every parameter value, not for these numbers only: a turn "
+            f"of {lost_names} is one the other coordinates make too, so any {lost_names} names "
+            "the same configuration up to them"
+        )
     pole = (
-        f"{where} is a pole of the coordinates (any {lost_names} names the same point: its row "
-        f"of M vanishes), so only {', '.join(m.coordinate_names[j] for j in idx)} was linearized"
+        f"{where} is a pole of the coordinates ({why}), so only "
+        f"{', '.join(m.coordinate_names[j] for j in idx)} was linearized"
     )
     radial = _radial(m, full_M, at_rest, q0, numbers, idx, lost)
     cyclic = all(j in free for j in lost)
@@ -1470,7 +1517,7 @@ def _radial(m, full_M, at_rest, q0, numbers, idx, lost) -> list[int]:
         point[i] += h
         with np.errstate(all="ignore"):
             M_h = np.array(at_rest(*point, *numbers)[0], dtype=float).reshape(n, n)
-        if all(abs(M_h[j, j]) > 1e-9 * inertia for j in lost):
+        if all(abs(M_h[j, j]) > 1e-9 * inertia for j in lost) and not _singular(M_h, 1e-9):
             out.append(i)
     return out
 
