@@ -4,8 +4,9 @@ Each particle's balance m a = F + R is written along the unit vectors of the fra
 is natural in (polar for a pendulum). The constraint force R is the unknown Lagrange never needs:
 projected on the directions the particle may move (∂r/∂q_j) the balances give back the equations
 of motion (D'Alembert, eq. 19–20); projected on the other directions they give R itself, here
-solved with q̈ from the equations of motion: the tension T(θ, θ̇) of a pendulum, the normal force
-of a hoop, the tension of the Atwood machine's string.
+solved with q̈ from the equations of motion: the tension F_T(θ, θ̇) of a pendulum, the normal
+force of a hoop, the tension of the Atwood machine's string. A tension is written F_T, as in the
+free-body diagram: T is the kinetic energy.
 """
 
 from __future__ import annotations
@@ -125,7 +126,7 @@ def _support_force(b: Any, R: Vector, m: Any) -> tuple[str, sp.Expr] | None:
 def _polar_lines(b: Any, anchor: str, ma: Vector, applied: Vector, m: Any) -> list[Line]:
     """A pendulum declared in x, y, balanced as the notes do: along ê_r (to the bob) and ê_θ.
 
-    Along the rod the tension T enters (m a·ê_r = ΣF·ê_r − T); across it nothing does.
+    Along the rod the tension F_T enters (m a·ê_r = ΣF·ê_r − F_T); across it nothing does.
     """
     rel = b.position - m.positions[anchor]
     if tidy(rel.dot(m.N.z), m) != 0:
@@ -134,13 +135,14 @@ def _polar_lines(b: Any, anchor: str, ma: Vector, applied: Vector, m: Any) -> li
     e_t = m.N.z.cross(e_r)
     name = sub(b.name)
     lines = []
-    for label, e, extra in (("r", e_r, " - T"), (r"\theta", e_t, "")):
+    tension = (rf" - F_{{T,{name}}}", f" - F_T_{b.name}")
+    for label, e, (extra, extra_plain) in (("r", e_r, tension), (r"\theta", e_t, ("", ""))):
         lhs, rhs = tidy(ma.dot(e), m), tidy(applied.dot(e), m)
         lines.append(
             Line(
                 f"{'radial' if label == 'r' else 'tangential'} balance of {b.name}",
                 rf"m a_{{{label}}} = {to_latex(lhs)} = {to_latex(rhs)}{extra}\quad({name})",
-                f"m a_{label.strip(chr(92))} = {to_plain(lhs)} = {to_plain(rhs)}{extra}",
+                f"m a_{label.strip(chr(92))} = {to_plain(lhs)} = {to_plain(rhs)}{extra_plain}",
             )
         )
     return lines
@@ -167,8 +169,8 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
             constraint_lines.append(
                 Line(
                     f"tension {f.body}",
-                    rf"T_{{{sub(f.body)}}} = {to_latex(tension)}",
-                    f"T_{f.body} = {to_plain(tension)}",
+                    rf"F_{{T,{sub(f.body)}}} = {to_latex(tension)}",
+                    f"F_T_{f.body} = {to_plain(tension)}",
                 )
             )
     solved_text = (

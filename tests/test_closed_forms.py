@@ -33,8 +33,8 @@ CASES = {
     "atwood_machine": lambda s: [(s["m1"] - s["m2"]) * s["g"] / (s["m1"] + s["m2"])],
     # ẍ = (2/3) g sin α for a uniform disk rolling without slipping
     "rolling_disk": lambda s: [sp.Rational(2, 3) * s["g"] * sp.sin(s["alpha"])],
-    # θ̈ = −(3g / 2L) sin θ: I_O = mL²/3 by the parallel-axis theorem
-    "physical_pendulum": lambda s: [-3 * s["g"] / (2 * s["L"]) * sp.sin(s["theta"])],
+    # θ̈ = −(3g / 2l) sin θ: I_O = ml²/3 by the parallel-axis theorem
+    "physical_pendulum": lambda s: [-3 * s["g"] / (2 * s["l"]) * sp.sin(s["theta"])],
     # m ẍ + c ẋ + k x = F0 cos ωt
     "spring_mass_damper": lambda s: [
         (s["F0"] * sp.cos(s["w"] * t) - s["c"] * s["x_dot"] - s["k"] * s["x"]) / s["m"]

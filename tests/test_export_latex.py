@@ -160,7 +160,7 @@ def test_safe_math_accepts_sympys_latex():
         sp.latex(sp.Matrix([[m, 0], [0, m * length**2]])),
         sp.latex(sp.Piecewise((1, theta > 0), (0, True))),
         sp.latex(sp.sqrt(sp.Abs(sp.cos(theta) - sp.Symbol("omega")))),
-        r"\vec{W}_{\text{bob\_1}} = - g m\hat{\jmath}",
+        r"\vec{F}_{g,\text{bob\_1}} = - g m\hat{\jmath}",
         r"\frac{\partial L}{\partial \dot{\theta}} = m l^{2} \dot{\theta}",
     ]
     for latex in cases:

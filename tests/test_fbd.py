@@ -67,19 +67,19 @@ def test_rolling_disk_has_normal_force_and_static_friction_at_the_contact():
 
 
 def test_physical_pendulum_pin_reaction_at_the_pin_by_newton_euler():
-    """Rod of length L about its end O, G at L/2: θ̈ = −(3g/2L) sin θ, and m a_G = m g + R gives
-    R·ê_r = −m (g cos θ + L θ̇²/2) (a pull toward O), R·ê_θ = m g sin θ / 4."""
+    """Rod of length l about its end O, G at l/2: θ̈ = −(3g/2l) sin θ, and m a_G = m g + R gives
+    R·ê_r = −m (g cos θ + l θ̇²/2) (a pull toward O), R·ê_θ = m g sin θ / 4."""
     (pin,) = placed("physical_pendulum")["rod"]
     assert pin["name"] == "R" and "pin" in pin["what"]
     assert pin["at"] == ["0", "0", "0"]  # O, not the centre of mass
-    m, L, g = 1.0, 1.0, 9.81
+    m, length, g = 1.0, 1.0, 9.81
     r = run("physical_pendulum")
     assert "tension" not in r["constraint_forces"]["rod"]  # not a rod's tension
     th, thd = np.array(r["q"]["theta"]), np.array(r["q_dot"]["theta"])
     e_r = np.stack([np.sin(th), -np.cos(th), 0 * th], axis=1)
     e_t = np.stack([np.cos(th), np.sin(th), 0 * th], axis=1)
     total = xyz(r["constraint_forces"]["rod"])
-    assert np.allclose((total * e_r).sum(1), -m * (g * np.cos(th) + L * thd**2 / 2), rtol=1e-8)
+    assert np.allclose((total * e_r).sum(1), -m * (g * np.cos(th) + length * thd**2 / 2), rtol=1e-8)
     assert np.allclose((total * e_t).sum(1), m * g * np.sin(th) / 4, rtol=1e-7, atol=1e-9)
 
 
@@ -105,11 +105,11 @@ def test_bead_on_a_hoop_feels_a_normal_force_not_a_tension():
 
 def test_atwood_masses_are_pulled_by_the_rope_and_no_per_body_claim_is_made():
     forces = placed("atwood_machine")
-    assert [f["name"] for f in forces["mass1"]] == ["T"] == [f["name"] for f in forces["mass2"]]
+    assert [f["name"] for f in forces["mass1"]] == ["F_T"] == [f["name"] for f in forces["mass2"]]
     notes = fbd_data("atwood_machine")["constraints"]
     for note in notes:
         assert "does no virtual work" not in note and "summed over all bodies" in note
-    # and indeed: T does virtual work on mass1 alone, none on the two together
+    # and indeed: F_T does virtual work on mass1 alone, none on the two together
     m1, m2, g = 2.0, 1.0, 9.81
     tension = 2 * m1 * m2 * g / (m1 + m2)
     r = run("atwood_machine", t_end=0.5)
@@ -140,7 +140,7 @@ def test_a_per_body_claim_holds_for_that_body(scene_id):
 
 def test_double_pendulum_inner_rod_pulls_along_itself_once_the_outer_rods_pull_is_taken_off():
     forces = placed("double_pendulum")
-    assert [(f["name"], f["part"]) for f in forces["bob1"]] == [("T", "pull"), ("T", "rest")]
+    assert [(f["name"], f["part"]) for f in forces["bob1"]] == [("F_T", "pull"), ("F_T", "rest")]
     r = run("double_pendulum")
     p1, p2 = xyz(r["positions"]["bob1"]), xyz(r["positions"]["bob2"])
     R1, R2 = xyz(r["constraint_forces"]["bob1"]), xyz(r["constraint_forces"]["bob2"])

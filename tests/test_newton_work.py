@@ -51,7 +51,7 @@ def test_pendulum_balance_is_written_in_polar_components_as_the_notes_do():
     steps, _, _ = newton(derivation_of_scene("simple_pendulum"))
     plain = steps[0].to_json()["plain"]
     assert "m a_theta = l*m*theta_ddot = -g*m*sin(theta)" in plain
-    assert "m a_r = -l*m*theta_dot**2 = g*m*cos(theta) - T" in plain
+    assert "m a_r = -l*m*theta_dot**2 = g*m*cos(theta) - F_T_bob" in plain
 
 
 def test_atwood_string_tension():

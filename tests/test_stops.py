@@ -1,7 +1,7 @@
 """Runs end where their model stops holding, at the moment a closed form (or our own event
 search on hand-written equations) puts it.
 
-Atwood machine: x = ½ a t², a = (m1 − m2) g / (m1 + m2), a mass reaches the pulley at x = L + d
+Atwood machine: x = ½ a t², a = (m1 − m2) g / (m1 + m2), a mass reaches the pulley at x = l + d
 (or x = −d). Incline: a block decelerating at g(μ cos α − sin α) sticks at t = v0 / that; with
 μ < tan α it reverses and slides down (a piecewise parabola). A projectile lands at the root of
 y0 + v t − ½ g t². A pendulum's string goes slack where m(g cos θ + l θ̇²) reaches 0.
@@ -37,13 +37,13 @@ def request_for(method: str, **kw) -> SimulationRequest:
 def test_atwood_heavier_mass1_stops_when_mass2_reaches_the_pulley(method):
     p = load_scene("atwood_machine")["parameters"]
     accel = (p["m1"] - p["m2"]) * p["g"] / (p["m1"] + p["m2"])
-    t_stop = math.sqrt(2 * (p["L"] + p["d"]) / accel)
+    t_stop = math.sqrt(2 * (p["l"] + p["d"]) / accel)
     result = simulate(scene_id="atwood_machine", request=request_for(method, t_end=3.0, fps=50))
     stop = result["stats"]["stop"]
     assert stop["name"] == "mass2_at_pulley"
     assert stop["t"] == pytest.approx(t_stop, abs=1e-6)
     assert result["t"][-1] == pytest.approx(t_stop, abs=1e-6)
-    assert result["q"]["x"][-1] == pytest.approx(p["L"] + p["d"], abs=1e-6)
+    assert result["q"]["x"][-1] == pytest.approx(p["l"] + p["d"], abs=1e-6)
     assert result["stats"]["status"] == "stopped"
     assert any(w.startswith("Stopped at") for w in result["warnings"])
 

@@ -1,4 +1,7 @@
-"""Step 2 (notes I.C, IV.A 2): generalized coordinates, n = 3N − k."""
+"""Step 2 (notes I.C, IV.A 2): generalized coordinates, n = 3N − k.
+
+The notes' k (number of constraints) and N (number of particles) are written out as numbers
+here: N is also the inertial frame, and k is the spring constant of many scenes."""
 
 from __future__ import annotations
 
@@ -15,15 +18,18 @@ def generalized_coordinates(model: Model, work: Work) -> Step:
     n = len(model.q)
     k = free - n
     count = (
-        f"$3N = {3 * particles}$"
+        rf"$3 \cdot {particles} = {free}$"
         if not rigid
         else rf"$3 \cdot {particles} + 6 \cdot {rigid} = {free}$"
     )
+    # the notes' letter for the count, unless the scene already means something else by k
+    taken = set(model.spec.parameters) | set(model.spec.coordinates)
+    absorbed = f"$k = {k}$" if "k" not in taken else f"{k}"
     qs = ", ".join(to_latex(q) for q in model.q)
     text = (
         f"{len(model.bodies)} bod{'y' if len(model.bodies) == 1 else 'ies'}: {count} coordinates "
         f"without constraints; the positions below use $n = {n}$ generalized coordinate"
-        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs $k = {k}$ holonomic constraint"
+        f"{'s' if n != 1 else ''}, so the scene's geometry absorbs {absorbed} holonomic constraint"
         f"{'s' if k != 1 else ''} "
         rf"(eq. 12). Each position $\vec r_i(q, t)$ satisfies {'it' if k == 1 else 'them'} for "
         "every value of $q$."

@@ -1,10 +1,11 @@
 """Step 1 (notes IV.A 1): the free-body diagram — every force on every body, frames, datum.
 
 Besides the applied forces, each body's constraint forces are named the way a textbook names them
-and placed where they act (`constraint_forces`): a rod's tension T at a bob, a track's or a wire's
+and placed where they act (`constraint_forces`): a rod's tension F_T at a bob, a track's or a wire's
 normal force N, a pin reaction R at the pin, the normal force N and static friction f_s at a
-rolling contact. Only the names, the points and the directions come from here (kinematics alone);
-the sizes are Newton's (`mechanics.newton`, R = m a − ΣF along a run).
+rolling contact. The tension is F_T, never a bare T: T is the kinetic energy two steps later.
+Only the names, the points and the directions come from here (kinematics alone); the sizes are
+Newton's (`mechanics.newton`, R = m a − ΣF along a run).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from sympy.physics.vector import Vector
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
+from mechanics.steps.energy import letter
 
 #: A kinematic quantity counts as zero when it is below this at every sampled state.
 ZERO = 1e-9
@@ -29,7 +31,8 @@ def body_forces(model: Model) -> dict[str, list[tuple[str, str, Vector]]]:
     if model.gravity is not None:
         g, down = model.gravity
         for b in model.bodies:
-            acting[b.name].append((rf"\vec{{W}}_{{{sub(b.name)}}}", "weight", b.mass * g * down))
+            # F_g as the notes write the weight (eq. 28): W is work in the notes and the work panel
+            acting[b.name].append((rf"\vec{{F}}_{{g,{sub(b.name)}}}", "weight", b.mass * g * down))
     for s in model.springs:
         d = model.positions[s.b] - model.positions[s.a]
         stretch = 1 if s.rest_length == 0 else (s.length - s.rest_length) / s.length
@@ -142,7 +145,7 @@ def rod_anchor(model: Model, name: str, sampler: _Sampler | None = None) -> str 
 
     It keeps a fixed distance from its anchor, the constraint does not move with time, and
     relative to the anchor it may move in every direction but along the rod: then its own
-    constraint force is the rod's pull along the rod, a tension T. A bead on a spinning hoop keeps
+    constraint force is the rod's pull along the rod, a tension F_T. A bead on a spinning hoop keeps
     its distance too, but the hoop also pushes it across: that is a normal force, not a tension.
     """
     s = sampler or _Sampler(model)
@@ -210,8 +213,9 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
         where = f"the pin at {pin}" if pin else "the pin"
         force = _force("R", name, f"pin reaction on {name}, at {where}", at, part="rest")
         return [force], (
-            f"the pin reaction R acts at {where}, a point of {name} that never moves: its virtual "
-            f"displacement is zero, so R does no virtual work (though R is not perpendicular to "
+            f"the pin reaction ${force['label']}$ acts at {where}, a point of {name} that never "
+            f"moves: its virtual displacement is zero, so ${force['label']}$ does no virtual "
+            "work (though it is not perpendicular to "
             rf"$\partial \vec r_G/\partial {to_latex(q)}$ in general)"
         )
     tangent = centre.diff(q, model.N)
@@ -236,10 +240,12 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
             along=_unit(tangent, model),
         ),
     ]
+    normal_label, friction_label = forces[0]["label"], forces[1]["label"]
     return forces, (
-        f"$N$ and $f_s$ act at the contact point, the point of {name} at rest while it rolls "
-        "without slipping: its virtual displacement is zero, so they do no virtual work (though "
-        rf"$f_s$ is along $\partial \vec r_G/\partial {to_latex(q)}$)"
+        f"${normal_label}$ and ${friction_label}$ act at the contact point, the point of {name} "
+        "at rest while it rolls without slipping: its virtual displacement is zero, so they do "
+        rf"no virtual work (though ${friction_label}$ is along "
+        rf"$\partial \vec r_G/\partial {to_latex(q)}$)"
     )
 
 
@@ -285,7 +291,7 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
         if anchor in names:  # the rod from `anchor` to b pulls on both its ends
             forces[anchor].append(
                 _force(
-                    "T",
+                    "F_T",
                     anchor,
                     f"pull of the rod from {anchor} to {b}",
                     anchor,
@@ -316,34 +322,26 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
         own = None  # (force entries, why they do no virtual work) when provable
         if rods[name] is not None:
             rod = rods[name]
-            own = (
-                [
-                    _force(
-                        "T",
-                        name,
-                        f"tension of the rod from {rod} to {name}",
-                        name,
-                        part="rest",
-                        toward=rod,
-                    )
-                ],
-                "the rod's pull T is along the rod",
+            tension = _force(
+                "F_T",
+                name,
+                f"tension of the rod from {rod} to {name}",
+                name,
+                part="rest",
+                toward=rod,
             )
+            own = ([tension], f"the rod's pull ${tension['label']}$ is along the rod")
         elif body.kind == "particle":
             k = s.rank(_directions(model, body.position))
             if not coupled and k < free:
                 where = "track" if k == 1 else "surface"
-                own = (
-                    [
-                        _force(
-                            "N", name, f"normal force of the {where} on {name}", name, part="rest"
-                        )
-                    ],
-                    f"the {where}'s normal force N is across it",
+                normal = _force(
+                    "N", name, f"normal force of the {where} on {name}", name, part="rest"
                 )
+                own = ([normal], f"the {where}'s normal force ${normal['label']}$ is across it")
             elif coupled and _straight_rope(model, name, s):
                 forces[name].append(
-                    _force("T", name, f"pull of the rope on {name}", name, part="rest")
+                    _force("F_T", name, f"pull of the rope on {name}", name, part="rest")
                 )
             elif coupled or k < free:
                 forces[name].append(
@@ -411,7 +409,7 @@ def free_body_diagram(model: Model, work: Work) -> Step:
       ``bodies``: per body ``{"body", "kind", "free_directions", "forces", "constraint_forces"}``;
         ``forces`` are the applied ones (label, kind, plain, components in N);
         ``constraint_forces`` each ``{"name", "label", "what", "on", "at", "part", ...}``:
-        ``name`` as a textbook writes it (T tension of a rod or rope, N normal force, f_s static
+        ``name`` as a textbook writes it (F_T tension of a rod or rope, N normal force, f_s static
         friction, R pin reaction or an unnamed resultant; ``symbol``: its letter and subscript
         in plain text, ``what``: in words), ``at`` where it acts: a place of the
         run's ``positions`` (a body, a point) or its N components as plain expressions in the
@@ -459,18 +457,26 @@ def free_body_diagram(model: Model, work: Work) -> Step:
         )
     heights = "every body at the height of O" if model.gravity is not None else ""
     rest = "every spring at its rest length" if model.springs else ""
+    V = letter(model, "V")
     datum = (
-        f"$V = 0$ with {' and '.join(filter(None, [heights, rest]))}"
+        f"${V} = 0$ with {' and '.join(filter(None, [heights, rest]))}"
         if heights or rest
-        else "$V$ as the scene's potentials give it"
+        else f"${V}$ as the scene's potentials give it"
     )
     text = (
         "Draw every force on every body, the constraint forces where they act. Weights, springs "
-        "and potentials are conservative and enter through $V$; dampers and applied forces do "
+        f"and potentials are conservative and enter through ${V}$; dampers and applied forces do "
         "non-conservative work and enter through $Q_j$. For ideal constraints the constraint "
         "forces on all bodies together do no virtual work (notes eq. 18–20); on one body alone "
         f"only when its constraints are its own. Datum: {datum}."
     )
+    if model.frames:  # ω_{D/N} below is the first place N appears
+        first = next(iter(model.frames))
+        text += (
+            r" Vectors are written along $\hat\imath, \hat\jmath, \hat k$ of N, the fixed "
+            rf"(inertial) frame (the notes' F); $\vec\omega_{{{first}/N}}$ is the angular "
+            f"velocity of frame {first} relative to N."
+        )
     if model.gravity is None:
         text += (
             r" There is no uniform gravity in this scene (no weight $m\vec g$ on any body), so "

@@ -64,7 +64,8 @@ def kinematics(model: Model, work: Work) -> Step:
             )
     text = (
         r"Write each body's position $\vec r_i(q, t)$ in the frame where it is natural and "
-        "differentiate in N (eq. 16)."
+        "differentiate in N (eq. 16). N is the fixed (inertial) frame, the notes' F, with unit "
+        r"vectors $\hat\imath, \hat\jmath, \hat k$; a subscript /N means relative to it."
     )
     if transport:
         text += (

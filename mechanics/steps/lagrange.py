@@ -7,12 +7,14 @@ import sympy as sp
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, d_dt, eq_line, partial, tidy
+from mechanics.steps.energy import letter, script_note
 
 
 def lagrange_equations(model: Model, work: Work) -> Step:
     """d/dt ∂L/∂q̇_j − ∂L/∂q_j = Q_j^NC, shown piece by piece as the notes do."""
     work.L = L = tidy(work.T - work.V, model)
-    lines = [eq_line("L", "L = T - V", L, "L")]
+    L_, T_, V_ = (letter(model, x) for x in "LTV")
+    lines = [eq_line("L", f"{L_} = {T_} - {V_}", L, "L")]
     work.eom_lhs = []
     for name, qi, qdi, Qj in zip(model.coordinate_names, model.q, model.qd, work.Q, strict=True):
         ql, qdl = to_latex(qi), to_latex(qdi)
@@ -25,15 +27,18 @@ def lagrange_equations(model: Model, work: Work) -> Step:
         work.dL_dq.append(dq)
         lines += [
             eq_line(
-                f"dL/d{name}_dot", rf"\frac{{\partial L}}{{\partial {qdl}}}", p, f"dL/d{name}_dot"
+                f"dL/d{name}_dot",
+                rf"\frac{{\partial {L_}}}{{\partial {qdl}}}",
+                p,
+                f"dL/d{name}_dot",
             ),
             eq_line(
                 f"d/dt dL/d{name}_dot",
-                rf"\frac{{d}}{{dt}}\frac{{\partial L}}{{\partial {qdl}}}",
+                rf"\frac{{d}}{{dt}}\frac{{\partial {L_}}}{{\partial {qdl}}}",
                 dp,
                 f"d/dt dL/d{name}_dot",
             ),
-            eq_line(f"dL/d{name}", rf"\frac{{\partial L}}{{\partial {ql}}}", dq, f"dL/d{name}"),
+            eq_line(f"dL/d{name}", rf"\frac{{\partial {L_}}}{{\partial {ql}}}", dq, f"dL/d{name}"),
             Line(
                 f"EoM {name}",
                 f"{to_latex(lhs)} = {to_latex(Qj)}",
@@ -41,11 +46,12 @@ def lagrange_equations(model: Model, work: Work) -> Step:
             ),
         ]
     text = (
-        r"Form $L = T - V$ (eq. 35). For each coordinate take $\partial L/\partial \dot q_j$, its "
-        r"time derivative and $\partial L/\partial q_j$; the equation of motion is "
-        r"$\frac{d}{dt}\frac{\partial L}{\partial \dot q_j} - \frac{\partial L}{\partial q_j}"
-        r" = Q_j^{NC}$ (eq. 36)."
-    )
+        rf"Form ${L_} = {T_} - {V_}$ (eq. 35). For each coordinate take "
+        rf"$\partial {L_}/\partial \dot q_j$, its time derivative and "
+        rf"$\partial {L_}/\partial q_j$; the equation of motion is "
+        rf"$\frac{{d}}{{dt}}\frac{{\partial {L_}}}{{\partial \dot q_j}} - "
+        rf"\frac{{\partial {L_}}}{{\partial q_j}} = Q_j^{{NC}}$ (eq. 36)."
+    ) + script_note(model, "L")
     return Step("lagrange", "Lagrangian and Euler–Lagrange equations", text, lines)
 
 

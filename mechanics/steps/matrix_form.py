@@ -7,6 +7,7 @@ import sympy as sp
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, eq_line, partial, tidy
+from mechanics.steps.energy import letter
 from mechanics.steps.lagrange import ratio
 
 #: q̈ is solved symbolically for at most this many coordinates ...
@@ -31,13 +32,17 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
         Line("f", rf"\mathbf{{f}} = {to_latex(f)}", f"f = {to_plain(f.T.tolist()[0])}"),
     ]
     text = r"Collect the $\ddot q$ terms: $\mathbf M(q, t)\,\ddot q = \mathbf f(q, \dot q, t)$. "
+    if "M" in model.spec.parameters or "M" in model.spec.coordinates:
+        text += r"(Bold $\mathbf M$ is the mass matrix, not the scene's parameter $M$.) "
     det = None
     if n <= SOLVE_MAX_COORDINATES:
         size = sp.count_ops([*M, *f])
         if size > SOLVE_OPS_BUDGET:
+            # bold 𝐌 as in the step's math: a scene may have a mass parameter called M
             work.warnings.append(
-                f"q̈ was not solved symbolically: M and f have {size} operations, past the "
-                f"budget of {SOLVE_OPS_BUDGET}; the simulation solves M q̈ = f numerically"
+                f"q̈ was not solved symbolically: the mass matrix 𝐌 and the forcing 𝐟 have {size} "
+                f"operations, past the budget of {SOLVE_OPS_BUDGET}; the simulation solves "
+                "𝐌 q̈ = 𝐟 numerically"
             )
         else:
             det = determinant(M, model)
@@ -70,7 +75,8 @@ def definiteness(det: sp.Expr | None, model: Model, listed: bool) -> str:
             r"$\det \mathbf M > 0$ for positive masses and lengths."
         )
     return (
-        r"$\mathbf M$ is symmetric and positive semidefinite (as $T \ge 0$); it is positive "
+        rf"$\mathbf M$ is symmetric and positive semidefinite (as ${letter(model, 'T')} \ge 0$); "
+        r"it is positive "
         r"definite, so that $\ddot q$ is defined, wherever $\det \mathbf M \neq 0$"
         + (" (below)." if listed else ".")
     )

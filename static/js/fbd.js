@@ -1,8 +1,10 @@
 // The free-body diagram at the current instant: the scene drawn faintly, and on every body each
-// force of the run (`forces` of /simulate: weight, spring, damper, applied) as a labelled arrow to
-// scale, plus the constraint forces (dashed), named and placed as the derivation's FBD step says
-// (`constraint_forces` of its data: a rod's tension T, a normal force N, static friction f_s at a
-// rolling contact, a pin reaction R at the pin), sized by Newton's R = m a − ΣF of the run.
+// force of the run (`forces` of /simulate: weight F_g, spring, damper, applied) as a labelled
+// arrow, plus the constraint forces (dashed), named and placed as the derivation's FBD step says
+// (`constraint_forces` of its data: a rod's tension F_T, a normal force N, static friction f_s at
+// a rolling contact, a pin reaction R at the pin), sized by Newton's R = m a − ΣF of the run.
+// Arrows are to scale: one px-per-newton for the whole diagram (`arrowLengths`), the largest force
+// MAX_ARROW px long; only a force too small to see is drawn at MIN_ARROW px, and the legend says so.
 import { SceneGeometry } from "./geometry.js";
 import { toSVG } from "./render.js";
 import { placeLabel, sceneShapes } from "./shapes.js";
@@ -13,6 +15,10 @@ export const FORCE_COLORS = {
   constraint: "#495057", potential: "#c2255c",
 };
 const W = 440;
+/** Length (px) of the diagram's largest force; every other arrow is shorter in proportion. */
+export const MAX_ARROW = 72;
+/** A shorter arrow would be all head (10 px): such a force is drawn this long, and named so. */
+export const MIN_ARROW = 12;
 const analysed = new WeakMap(); // result -> its SceneGeometry: the diagram redraws often
 
 let measurer = null;
@@ -25,11 +31,27 @@ function textWidth(text, px) {
   return measurer.measureText(text).width;
 }
 
-/** `\vec{F}_{\text{spring}}` → {text: "F", sub: "spring"}. */
+/** `\vec{F}_{\text{spring}}` → {text: "F", sub: "spring"}; `\vec{F}_{g,\text{bob}}` → {text: "F",
+ * sub: "g,bob"}. */
 export function labelParts(latex) {
-  const m = latex.match(/^\s*(?:\\vec\{([^}]*)\}|([A-Za-z]+))\s*(?:_\{?(?:\\text\{|\\mathrm\{)?([^{}]*)\}?\}?)?/);
-  if (!m) return { text: latex.replace(/[\\{}]/g, ""), sub: "" };
-  return { text: (m[1] || m[2] || "").replace(/[\\{}]/g, ""), sub: (m[3] || "").replace(/[\\{}]/g, "") };
+  const m = latex.match(/^\s*(?:\\vec\{([^}]*)\}|([A-Za-z]+))\s*(?:_(\{(?:[^{}]|\{[^{}]*\})*\}|\w))?/);
+  const bare = (x) => x.replace(/\\(?:text|mathrm)\{/g, "").replace(/[\\{}]/g, "");
+  if (!m) return { text: bare(latex), sub: "" };
+  return { text: bare(m[1] || m[2] || ""), sub: bare(m[3] || "") };
+}
+
+/** Arrow lengths (px) for force magnitudes (N): one scale for all, the largest MAX_ARROW long;
+ * a force that would be shorter than MIN_ARROW is drawn at MIN_ARROW and marked `short`.
+ * Zero (or negligible) forces get length 0: they are not drawn. */
+export function arrowLengths(sizes) {
+  const biggest = Math.max(...sizes, 1e-12);
+  const pxPerNewton = MAX_ARROW / biggest;
+  const arrows = sizes.map((size) => {
+    if (!(size >= 1e-9 * biggest)) return { length: 0, short: false };
+    const length = size * pxPerNewton;
+    return length < MIN_ARROW ? { length: MIN_ARROW, short: true } : { length, short: false };
+  });
+  return { pxPerNewton, arrows };
 }
 
 /** Draw into `svg` for sample i; `angles` are the stage's 3-D yaw and pitch; `placed` is the
@@ -57,6 +79,10 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   arrows.push(...potentialForces(spec, result, parameters, i, arrows));
   const kinds = new Set();
   const biggest = Math.max(...arrows.map((a) => a.size), 1e-12);
+  const scale = arrowLengths(arrows.map((a) => a.size));
+  const lengths = new Map(arrows.map((a, k) => [a, scale.arrows[k]]));
+  const short = []; // labels of the forces drawn at the minimum length
+  const measured = []; // {label, on, size, length}: what the diagram drew, for tests and readers
   const occupied = [];
   const used = new Set();
   const drawn = []; // [body, direction]: arrows alike in direction are drawn side by side
@@ -76,7 +102,7 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
     } else {
       const d = view.direction(p, [f.x / f.size, f.y / f.size, f.z / f.size]);
       if (!d[0] && !d[1]) continue;
-      const len = 22 + 50 * (f.size / biggest);
+      const { length: len, short: tiny } = lengths.get(f);
       const where = String(p.map((v) => v.toFixed(6)));
       const alike = drawn.filter(([at, e]) => at === where && e[0] * d[0] + e[1] * d[1] > 0.94).length;
       drawn.push([where, d]);
@@ -90,6 +116,8 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
         occupied.push([px - 3, py - 3, px + 3, py + 3]);
       }
       const { text, sub } = f.symbol ? { text: f.symbol[0], sub: f.symbol[1] } : labelParts(f.label);
+      measured.push({ label: sub ? `${text}_${sub}` : text, on: f.on, size: f.size, length: len, short: tiny });
+      if (tiny && !short.includes(sub ? `${text}_${sub}` : text)) short.push(sub ? `${text}_${sub}` : text);
       const key = `${text}_${sub}@${f.on}`;
       if (used.has(key)) continue;
       used.add(key);
@@ -112,10 +140,12 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   svg.innerHTML = toSVG(shapes);
   svg.dataset.frame = String(i);
   svg.dataset.arrows = String(arrows.filter((a) => a.size >= 1e-9 * biggest).length);
+  svg.dataset.scale = JSON.stringify({ px_per_newton: scale.pxPerNewton, arrows: measured });
   const named = arrows.filter((a) => a.kind === "constraint" && a.size >= 1e-9 * biggest);
   svg.dataset.constraints = JSON.stringify(named.map(({ name, on, at, x, y, z, what }) =>
     ({ name, on, what, at: at || geom.at(on, i), centre: geom.at(on, i), force: [x, y, z] })));
   kinds.constraints = [...new Set(named.map((a) => a.name))];
+  kinds.short = short;
   return kinds;
 }
 
@@ -286,22 +316,28 @@ function torqueArc([x, y], sign, color) {
     { t: "arrow", a: prev, b: end, color, width: 2.2, head: 8 }];
 }
 
-const CONSTRAINT_NAMES = { T: "T tension of a rod or rope", N: "N normal force", f_s: "f_s static friction",
+// F_T, not T: T is the kinetic energy of the derivation's energy step
+const CONSTRAINT_NAMES = { F_T: "F_T tension of a rod or rope", N: "N normal force", f_s: "f_s static friction",
   R: "R pin reaction or resultant" };
 
 /** The legend under the diagram: one swatch per kind of force drawn. */
 export function fbdLegend(box, kinds) {
   const named = (kinds.constraints || []).map((n) => CONSTRAINT_NAMES[n] || n).join(", ");
-  const names = { weight: "weight", spring: "spring", damper: "damper", force: "applied force", torque: "applied torque",
+  const names = { weight: "weight F_g = mg", spring: "spring", damper: "damper", force: "applied force", torque: "applied torque",
     constraint: `constraint force, dashed${named ? ` (${named})` : ""}`, potential: "force of a potential V" };
-  const key = [...kinds].sort().join() + named;
+  const short = kinds.short || [];
+  const key = [...kinds].sort().join() + named + short.join();
   if (box.dataset.kinds === key) return;
   box.dataset.kinds = key;
+  const scale = document.createElement("span");
+  scale.className = "fbd-scale";
+  scale.textContent = "arrows to scale" + (short.length
+    ? ` (except ${short.join(", ")}: too small to draw, shown at the minimum length)` : "");
   box.replaceChildren(...Object.keys(names).filter((k) => kinds.has(k)).map((k) => {
     const span = document.createElement("span");
     span.className = `swatch ${k}`;
     span.style.setProperty("--c", FORCE_COLORS[k]);
     span.textContent = names[k];
     return span;
-  }));
+  }), scale);
 }

@@ -246,7 +246,7 @@ def test_the_editors_own_spec_gets_a_live_preview_too(server, page):
 
 def test_the_preview_ends_where_a_mass_reaches_the_pulley(server, page):
     """The Atwood machine from rest: x = ½ a t², a = (m1 − m2) g / (m1 + m2), and the spec's stop
-    'mass2 reaches the pulley' at x = L + d, so t = sqrt(2 (L + d) / a). The preview watches the
+    'mass2 reaches the pulley' at x = l + d, so t = sqrt(2 (l + d) / a). The preview watches the
     spec's stops as the server does and ends there."""
     p = page.page
     p.goto(f"{server}/scenes/atwood_machine")
@@ -256,7 +256,7 @@ def test_the_preview_ends_where_a_mass_reaches_the_pulley(server, page):
                    s.dispatchEvent(new Event('input', { bubbles: true })); }"""
     )
     p.wait_for_function("document.querySelector('#canvas').dataset.previewStop")
-    m1, m2, d, length, g = (float(p.input_value(f"#n-{k}")) for k in ("m1", "m2", "d", "L", "g"))
+    m1, m2, d, length, g = (float(p.input_value(f"#n-{k}")) for k in ("m1", "m2", "d", "l", "g"))
     a = (m1 - m2) * g / (m1 + m2)
     expected = math.sqrt(2 * (length + d) / a)
     assert float(p.get_attribute("#canvas", "data-preview-stop")) == pytest.approx(

@@ -337,9 +337,9 @@ CONSTRAINT_NAMES = {
     "rolling_disk": {"disk": ["N", "f_s"]},
     "physical_pendulum": {"rod": ["R"]},
     "bead_on_hoop": {"bead": ["N"]},
-    "simple_pendulum": {"bob": ["T"]},
-    "atwood_machine": {"mass1": ["T"], "mass2": ["T"]},
-    "double_pendulum": {"bob1": ["T", "T"], "bob2": ["T"]},
+    "simple_pendulum": {"bob": ["F_T"]},
+    "atwood_machine": {"mass1": ["F_T"], "mass2": ["F_T"]},
+    "double_pendulum": {"bob1": ["F_T", "F_T"], "bob2": ["F_T"]},
 }
 
 
