@@ -12,7 +12,16 @@ import math
 import re
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StringConstraints, field_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    StringConstraints,
+    field_validator,
+)
+
+from mechanics.units import BASE, UnitError, parse_unit
 
 #: Budgets on a posted spec: a spec past them is refused before any algebra runs.
 MAX_COORDINATES = 6
@@ -24,8 +33,23 @@ MAX_TEXT = 400
 
 IDENT = r"^[A-Za-z][A-Za-z0-9_]{0,23}$"
 Ident = Annotated[str, StringConstraints(pattern=IDENT)]
+
+
+def _not_a_bool(value: Any) -> Any:
+    """JSON true is not the number 1: pydantic's lax float took it as one, so a spec saying
+    ``"mass": true`` ran with a mass of 1 and no word about it."""
+    if isinstance(value, bool):
+        raise ValueError("must be a number or an expression, not true or false")
+    return value
+
+
+#: A number: JSON true and "3" are refused (strict), an integer is a number.
+Number = Annotated[float, Field(strict=True)]
 #: An expression in the plain-text convention, or a number.
-Expr = Annotated[str, StringConstraints(max_length=MAX_EXPR_LENGTH)] | float | int
+Expr = Annotated[
+    Annotated[str, StringConstraints(max_length=MAX_EXPR_LENGTH)] | float | int,
+    BeforeValidator(_not_a_bool),
+]
 Text = Annotated[str, StringConstraints(max_length=MAX_TEXT)]
 
 #: Names a scene may not take for itself: they mean something in every expression.
@@ -98,7 +122,7 @@ class Body(_Model):
 
 class Gravity(_Model):
     acceleration: Expr
-    direction: Annotated[list[float], Field(min_length=2, max_length=3)] = [0, -1, 0]
+    direction: Annotated[list[Number], Field(min_length=2, max_length=3)] = [0, -1, 0]
 
     @field_validator("direction")
     @classmethod
@@ -150,7 +174,7 @@ class Stop(_Model):
     message: Text
     when: Expr | None = None
     tension: Ident | None = None
-    along: Annotated[list[float], Field(min_length=2, max_length=3)] | None = None
+    along: Annotated[list[Number], Field(min_length=2, max_length=3)] | None = None
     crossing: Literal["falls", "any"] = "falls"
     only_if: Expr | None = None
 
@@ -167,7 +191,7 @@ class SceneSpec(_Model):
     coordinates: Annotated[list[Ident], Field(min_length=1, max_length=MAX_COORDINATES)]
     #: Coordinates that never go negative (a radius): lets sqrt(r**2) print as r, not |r|.
     positive_coordinates: list[Ident] = []
-    parameters: Annotated[dict[Ident, float], Field(max_length=MAX_PARAMETERS)] = {}
+    parameters: Annotated[dict[Ident, Number], Field(max_length=MAX_PARAMETERS)] = {}
     units: dict[Ident, Annotated[str, StringConstraints(max_length=40)]] = {}
     frames: _items(Frame) = []
     points: _items(PointSpec) = []
@@ -179,7 +203,7 @@ class SceneSpec(_Model):
     torques: _items(Force) = []
     potentials: _items(Potential) = []
     stops: _items(Stop) = []
-    initial: Annotated[dict[str, float], Field(max_length=2 * MAX_COORDINATES)] = {}
+    initial: Annotated[dict[str, Number], Field(max_length=2 * MAX_COORDINATES)] = {}
 
     @field_validator("parameters", "initial")
     @classmethod
@@ -265,6 +289,12 @@ def check_names(spec: SceneSpec) -> None:
         declare(f.name, f"frames[{i}].name")
         if f.parent not in frames:
             err(f"frames[{i}].parent", f"unknown frame '{f.parent}' (declare parents first)")
+        if f.unit_vectors is not None and len(set(f.unit_vectors)) < len(f.unit_vectors):
+            err(
+                f"frames[{i}].unit_vectors",
+                "three different names, one per axis: "
+                f"{', '.join(f.unit_vectors)} would print two axes alike",
+            )
         frames.add(f.name)
     places = {"O"}
     for i, p in enumerate(spec.points):
@@ -303,7 +333,13 @@ def check_names(spec: SceneSpec) -> None:
                 err(f"{group}[{i}].b", "both ends are the same place")
     bodies = {b.name: b for b in spec.bodies}
     for i, f in enumerate(spec.forces):
-        if f.on not in places:
+        if f.on == "O":
+            err(
+                f"forces[{i}].on",
+                "O is the fixed origin: a force on it does no work and moves nothing (the "
+                "support takes it); apply it to a body or a point that moves",
+            )
+        elif f.on not in places:
             err(f"forces[{i}].on", f"unknown point or body '{f.on}'")
         check_position(f.vector, f"forces[{i}].vector", places)
     for i, f in enumerate(spec.torques):
@@ -334,9 +370,18 @@ def check_names(spec: SceneSpec) -> None:
     for name in spec.initial:
         if name not in allowed_initial:
             err(f"initial.{name}", f"unknown coordinate or velocity '{name}'")
-    for name in spec.units:
+    for name, unit in spec.units.items():
         if name not in spec.parameters and name not in spec.coordinates:
             err(f"units.{name}", f"unknown parameter or coordinate '{name}'")
+            continue
+        try:
+            parse_unit(unit)
+        except UnitError:
+            err(
+                f"units.{name}",
+                f"cannot read the unit '{unit}': write products and quotients of "
+                f"{', '.join(BASE)} with integer powers (kg*m^2, m/s^2, N*s/m)",
+            )
     if errors:
         raise SpecError(errors)
 

@@ -148,3 +148,38 @@ def test_the_inertia_limits_agree_with_a_sampled_mass_distribution():
             "izx": tensor[2, 0],
         }
         assert _inertia_errors("bodies[0].inertia", "b's inertia", entries) == []
+
+
+@pytest.mark.parametrize("field", ["t_end", "fps", "dt", "rtol", "atol"])
+def test_json_true_is_not_a_number_in_a_request(client, field):
+    body = {"scene_id": "simple_pendulum", "method": "rk4", "dt": 0.01, field: True}
+    r = client.post("/api/v1/simulate", json=body)
+    assert fields(r) == [field]
+
+
+@pytest.mark.parametrize(
+    "path, value, field",
+    [
+        (("parameters", "m"), True, "parameters.m"),
+        (("initial", "x"), True, "initial.x"),
+        (("bodies", 0, "mass"), True, "bodies[0].mass"),
+        (("springs", 0, "k"), False, "springs[0].k"),
+        (("units",), {"x": "banana"}, "units.x"),
+        (("forces",), [{"on": "O", "vector": [1, 0, 0]}], "forces[0].on"),
+        (
+            ("frames",),
+            [{"name": "A", "axis": "z", "angle": "x", "unit_vectors": ["e", "e", "e"]}],
+            "frames[0].unit_vectors",
+        ),
+    ],
+)
+def test_lax_input_in_a_spec_is_refused_naming_the_field(client, path, value, field):
+    r = simulate(client, with_(SPRING, path, value))
+    assert fields(r) == [field]
+    assert not any("Value error" in e["message"] for e in r.json()["detail"])
+
+
+def test_readable_units_and_integers_still_pass(client):
+    spec = with_(SPRING, ("units",), {"x": "m", "k": "N/m", "m": "kg"})
+    spec["parameters"] = {"m": 1, "k": 2}  # integers are numbers
+    assert simulate(client, spec).status_code == 200
