@@ -11,9 +11,12 @@ numeric search (Newton from a capped set of starts), whose roots are matched to 
 added. A coordinate is an angle, wrapped into (−π, π], when the equations are 2π-periodic in it (it
 enters only through sin/cos of itself), whatever its declared units say.
 
-Linearizing about each gives M δq̈ + C δq̇ + K δq = 0 (C: damping and the gyroscopic/Coriolis
-terms). Stability and frequencies come from the eigenvalues of the first-order system, not from K
-alone: a turntable's Coriolis terms split and can even restore frequencies K alone gets wrong.
+Linearizing about each gives M δq̈ + C δq̇ + K δq = 0 (C: damping and the gyroscopic terms,
+Coriolis where a frame turns or forces that do no work, a magnetic one). Stability and frequencies
+come from the eigenvalues of the first-order system, not from K alone: a turntable's Coriolis
+terms split and can even restore frequencies K alone gets wrong. 'Stable by the potential' also
+needs the velocity-dependent forces to do no positive work, which no linearization sees (c ẋ³);
+and a K that is not symmetric (a follower load) has no potential behind it at all.
 
 The module is past the house's ~400 lines because the root search, its checks and the stability
 verdict are one procedure whose parts only make sense together.
@@ -1236,7 +1239,8 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
     at = sp.expand(power.xreplace(values)) if power != 0 else power
     if at == 0:  # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0
         return Power("dissipative" if dampers else "no work")
-    if _never_positive(m, at) or _quadratic_wins(m, at, q0):
+    proven = _once(d, "never positive", at, lambda: _never_positive(m, at))
+    if proven or _quadratic_wins(m, at, q0):
         return Power("dissipative", text)
     return Power("no sign", text)
 
