@@ -2,7 +2,8 @@
 // time (→, space, PageDown reveal the next; ←, PageUp hide it), p plays or pauses, f full screen.
 // A step taller than the screen (a double pendulum's Euler–Lagrange step is three screens) is paged
 // through first: the same keys scroll it a screen at a time before the next step is revealed, and
-// the counter says when more of it lies below. The counter sits in the sticky header in lecture
+// the counter says when more of it lies below; ← pages back up through it, then hides it and
+// shows the step before from its title (just under the sticky header). The counter sits in the sticky header in lecture
 // mode, so the room always sees where it is; the page's address keeps the step (?step=, from 0),
 // and a link with one opens scrolled to that step.
 // The derivation stands beside the animation, so in lecture mode it is moved next to it in the
@@ -141,7 +142,7 @@ export class Lecture {
 
   step(delta) {
     this.revealed += delta;
-    const shown = this.apply(delta < 0 ? "end" : true);
+    const shown = this.apply(true);
     this.onStep?.(this.revealed);
     return shown;
   }
@@ -191,11 +192,10 @@ export class Lecture {
   }
 
   /** Show the first `revealed` steps (all of them outside lecture mode); `scroll` brings the
-   * current one into view: its start (a step just revealed), its title under the header ("top":
-   * a linked step), or, back from the next step ("end"), the whole of it with its title under
-   * the header when it fits the screen, else its last screen (where the room left it; ← then
-   * pages back up through it). Hiding the next step shortens the page, and the browser clamps
-   * the scroll to it: the step shown was left with its last line under the header. */
+   * current one (a step just revealed, or the one before, back from it) to its title just under
+   * the sticky header unless all of it is on the screen already; "top" always (a linked step).
+   * Back from a step: hiding it shortens the page and the browser clamps the scroll, which left
+   * the step before with its last line under the header and nothing of it on the screen. */
   apply(scroll = false) {
     const steps = [...this.list.querySelectorAll(":scope > .step")];
     this.revealed = Math.max(1, Math.min(this.revealed, steps.length || 1));
@@ -208,17 +208,9 @@ export class Lecture {
     this.#count();
     return fitEquations(this.list).then(() => { // a step just shown is measured only now
       if (!scroll || !this.on || !last) return;
-      // a step just revealed starts under the header (all of it when it fits below what is shown)
       const r = last.getBoundingClientRect(), top = this.#headerBottom();
       const whole = r.top >= top && r.bottom <= innerHeight;
-      if (scroll === "top") {
-        window.scrollBy(0, r.top - top - 8);
-      } else if (scroll === "end" && !whole) {
-        const fits = r.height <= innerHeight - top - 16;
-        window.scrollBy(0, fits ? r.top - top - 8 : r.bottom - innerHeight + 16);
-      } else if (scroll !== "end" && !whole) {
-        window.scrollBy(0, r.top - top - 8);
-      }
+      if (scroll === "top" || !whole) window.scrollBy(0, r.top - top - 8);
       this.#count();
     });
   }

@@ -22,6 +22,14 @@ SEEN = """() => {
 }"""
 
 
+#: The current step runs on below the screen.
+TALLER_THAN_SCREEN = """() => {
+  const top = document.querySelector('body > header').getBoundingClientRect().bottom;
+  const r = document.querySelector('#steps > .step.current').getBoundingClientRect();
+  return r.height > innerHeight - top;
+}"""
+
+
 @pytest.mark.parametrize("size", [(1280, 720), (1024, 768)])
 def test_the_arrow_key_shows_every_equation_of_a_long_derivation(server, browser, size):
     ctx = browser.new_context(viewport={"width": size[0], "height": size[1]}, bypass_csp=True)
@@ -45,15 +53,20 @@ def test_the_arrow_key_shows_every_equation_of_a_long_derivation(server, browser
         missed = sorted(set(range(total)) - seen)
         assert not missed, f"{len(missed)} of {total} equation lines never on screen: {missed}"
         assert more_said  # its Euler–Lagrange step is taller than the screen
-        # ← hides the steps again, paging back up through a long one before hiding it
+        # ← hides the steps again, the step before coming back from its title; a long one paged
+        # into with → is paged back up with ← before it is hidden
         paged_back = False
         for _ in range(120):
-            revealed, y = p.get_attribute("#steps", "data-revealed"), p.evaluate("scrollY")
-            if revealed == "1" and y == 0:
+            revealed = p.get_attribute("#steps", "data-revealed")
+            if revealed == "1":
                 break
             press(p, "ArrowLeft")
-            same = p.get_attribute("#steps", "data-revealed") == revealed
-            paged_back |= same and p.evaluate("scrollY") < y
+            if p.evaluate(TALLER_THAN_SCREEN):
+                press(p, "ArrowRight")  # the next screen of it (the next step stays hidden)
+                y = p.evaluate("scrollY")
+                press(p, "ArrowLeft")
+                same = p.get_attribute("#steps", "data-revealed") == str(int(revealed) - 1)
+                paged_back |= same and p.evaluate("scrollY") < y
         assert p.get_attribute("#steps", "data-revealed") == "1"
         assert paged_back
     finally:
