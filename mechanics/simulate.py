@@ -18,6 +18,7 @@ import sympy as sp
 from scipy.integrate import cumulative_simpson
 
 from mechanics.divergence import compare_runs, worth_classifying
+from mechanics.expr import to_plain
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.model import physical_limit_errors
 from mechanics.native import NativeUnavailable
@@ -147,7 +148,49 @@ def _at(fn: Any, t0: float, y0: np.ndarray, n: int, params: list[float]) -> list
 def check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any) -> None:
     """The state a run starts from must lie where the derived equations hold: every branched
     spring on the side it was derived for and off its anchor, a mass matrix that can be
-    inverted, and numbers a double can hold (declared stops: `stops.refuse_passed_stops`)."""
+    inverted, and numbers a double can hold (declared stops: `stops.refuse_passed_stops`).
+
+    A start at (or past) the end of a position's domain (x = l√θ at θ = 0) makes M infinite
+    there, which read as "M overflows double precision: pick units"; it is refused as what it
+    is, naming the coordinates whose value puts it there."""
+    try:
+        _check_state(c, params, y0, req)
+    except SpecError:
+        at_end = _at_domain_end(c, params, y0)
+        if at_end is not None:
+            raise SpecError([at_end]) from None
+        raise
+
+
+def _at_domain_end(c: CompiledScene, params: list[float], y0: np.ndarray) -> dict | None:
+    """The 422 entry for a start at or past a position's domain end, else None."""
+    m, n = c.derivation.model, c.n
+    for stop, spec in zip(c.stops, c.stop_specs, strict=True):
+        if stop.kind != "domain":
+            continue
+        with np.errstate(all="ignore"):
+            value = float(np.asarray(stop.value(0.0, *y0[:n], *y0[n : 2 * n], *params)[0]))
+        if value > 0:
+            continue
+        involved = [
+            name for name, q in zip(m.coordinate_names, m.q, strict=True) if spec.when.has(q)
+        ]
+        where = ", ".join(
+            f"{q} = {y0[j]:g}" for j, q in enumerate(m.coordinate_names) if q in involved
+        )
+        end = to_plain(spec.when)
+        what = stop.message.split(" is undefined")[0]  # "the position of b"
+        return {
+            "field": ", ".join(f"initial.{q}" for q in involved) or "initial",
+            "message": f"the run would start {'at' if value == 0 else 'past'} the end of the "
+            f"domain of coordinates where {what} is defined ({where}): it is undefined for "
+            f"{end} < 0, and at {end} = 0 the equations of motion cannot be evaluated (the mass "
+            f"matrix is infinite or singular there); start where {end} > 0",
+        }
+    return None
+
+
+def _check_state(c: CompiledScene, params: list[float], y0: np.ndarray, req: Any) -> None:
     n, m = c.n, c.derivation.model
     errors = []
     names = ", ".join(f"initial.{q}" for q in c.coordinates if q in req.initial) or "initial"

@@ -183,3 +183,27 @@ def test_readable_units_and_integers_still_pass(client):
     spec = with_(SPRING, ("units",), {"x": "m", "k": "N/m", "m": "kg"})
     spec["parameters"] = {"m": 1, "k": 2}  # integers are numbers
     assert simulate(client, spec).status_code == 200
+
+
+ROOT = {
+    "title": "Bead on a root curve",
+    "coordinates": ["th"],
+    "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
+    "bodies": [{"name": "b", "mass": "m", "position": ["l*sqrt(th)", "-l*th", 0]}],
+    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    "initial": {"th": 0.5},
+}
+
+
+@pytest.mark.parametrize("th", [0.0, -0.1])
+def test_a_start_at_a_domain_end_names_the_coordinate_not_the_units(client, th):
+    """x = l√θ: ẋ = l θ̇ /(2√θ), so M = m l²(1/(4θ) + 1) is infinite at θ = 0 and undefined
+    below: the start's coordinate is at fault, not the size of the parameters."""
+    r = simulate(client, ROOT, initial={"th": th})
+    assert fields(r) == ["initial.th"]
+    message = r.json()["detail"][0]["message"]
+    assert "domain" in message and "th > 0" in message and "units" not in message
+
+
+def test_inside_the_domain_the_root_curve_runs(client):
+    assert simulate(client, ROOT).status_code == 200

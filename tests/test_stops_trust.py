@@ -301,7 +301,7 @@ def test_a_position_whose_root_never_ends_has_no_domain_stop():
 def test_a_position_started_outside_its_domain_is_refused():
     spec = pendulum(position=["l*sqrt(theta)", "-l*cos(theta)", 0], initial={"theta": -0.2})
     errors = refused(spec)
-    assert errors[0]["field"] == "initial"
+    assert errors[0]["field"] == "initial.theta"  # the coordinate that puts it there
 
 
 # --- a root of a square in a position ----------------------------------------------------------
