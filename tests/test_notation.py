@@ -161,7 +161,7 @@ def test_the_frame_n_is_defined_where_it_is_first_used(scene_id):
     assert "N is the fixed (inertial) frame, the notes' F" in s["kinematics"]["text"]
     fbd = s["fbd"]
     if any("/N}" in x for x in fbd["latex"]):  # ω_{D/N} already in the first step
-        assert "of N, the fixed (inertial) frame (the notes' F)" in fbd["text"]
+        assert "N is the fixed (inertial) frame, the notes' F" in fbd["text"]
 
 
 def test_the_rolling_disks_normal_force_is_a_vector_with_its_body():

@@ -473,8 +473,8 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     if model.frames:  # ω_{D/N} below is the first place N appears
         first = next(iter(model.frames))
         text += (
-            r" Vectors are written along $\hat\imath, \hat\jmath, \hat k$ of N, the fixed "
-            rf"(inertial) frame (the notes' F); $\vec\omega_{{{first}/N}}$ is the angular "
+            r" N is the fixed (inertial) frame, the notes' F, with unit vectors "
+            rf"$\hat\imath, \hat\jmath, \hat k$; $\vec\omega_{{{first}/N}}$ is the angular "
             f"velocity of frame {first} relative to N."
         )
     if model.gravity is None:
