@@ -55,6 +55,9 @@ MAX_TRIG_MULTIPLE = 8
 #: A number typed within this relative distance of a simple one (a fraction with a denominator
 #: up to NEAR_MISS_DENOMINATOR) is a near miss of it: 1.9999999999 of 2, 0.49999999999 of 1/2.
 NEAR_MISS = 1e-6
+#: Feedback term by term expands sin(n θ) only up to this n (the proofs stop at
+#: MAX_TRIG_MULTIPLE): sin(10¹⁴ θ) expanded would never finish.
+MAX_CANONICAL_MULTIPLE = 64
 NEAR_MISS_DENOMINATOR = 1000
 
 
@@ -113,6 +116,21 @@ def _expansion_size(expr: sp.Expr, cap: int) -> int:
     return 1
 
 
+def _huge_multiple(expr: sp.Expr) -> bool:
+    """Does ``expr`` hold sin(n θ) (or cos, tan, ...) with an integer n past
+    MAX_CANONICAL_MULTIPLE? Expanding it is a Chebyshev polynomial of degree n: never for 10¹⁴."""
+    return any(
+        n.is_Integer and abs(n) > MAX_CANONICAL_MULTIPLE
+        for f in expr.atoms(sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+        for n in (a.as_coeff_Mul()[0] for a in sp.Add.make_args(f.args[0]))
+    )
+
+
+def _tidy(expr: sp.Expr, model: Any, **options: Any) -> sp.Expr:
+    """The derivation's tidy(), which expands trig: an answer's sin(10¹⁴ θ) is left as typed."""
+    return expr if _huge_multiple(expr) else tidy(expr, model, **options)
+
+
 def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
     """Is ``expr`` identically zero? True or False only on an exact argument, None when sympy
     cannot tell within the size budget.
@@ -144,7 +162,7 @@ def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
         return True
     if len(cases) == 1 and results[0] is False:
         return False  # with a case split, a non-zero branch may be one no state reaches
-    if small and tidy(expr, model) == 0:  # trig beside exp or sqrt: the derivation's own pass
+    if small and _tidy(expr, model) == 0:  # trig beside exp or sqrt: the derivation's own pass
         return True
     if (
         small
@@ -396,9 +414,13 @@ def _typed_decimal(r: sp.Rational) -> bool:
 def _as_decimal(r: sp.Rational) -> sp.Float:
     """The exact decimal of a rational p/(2ᵃ5ᵇ), as a Float holding all of its digits."""
     with localcontext() as context:
-        context.prec = len(str(r.p)) + len(str(r.q)) + 2
+        context.prec = min(len(str(r.p)) + len(str(r.q)) + 2, MAX_SHOWN_DIGITS)
         decimal = (Decimal(int(r.p)) / Decimal(int(r.q))).normalize()
     return sp.Float(str(decimal), max(1, len(decimal.as_tuple().digits)))
+
+
+#: The most significant digits a decimal is shown with (past them it is rounded, for reading).
+MAX_SHOWN_DIGITS = 40
 
 
 def inline(expr: sp.Expr) -> str:
@@ -558,7 +580,7 @@ class _Judge:
             for sym in (to_sym[q], to_sym[qd]):
                 if plain.has(sym) and zero_proof(plain.diff(sym), self.m) is not True:
                     return False
-        shown = tidy(-diff, self.m)
+        shown = _tidy(-diff, self.m)
         term = f", {inline(shown)}," if sp.count_ops(shown) <= 30 else ""
         fb.append(
             f"Your L falls short of T − V by a function of t only{term} so no equation of "
@@ -616,7 +638,7 @@ class _Judge:
             sp.count_ops(diff) <= PROOF_OPS
             and _expansion_size(diff, MAX_NORMAL_TERMS) <= MAX_NORMAL_TERMS
         )
-        shown = tidy(diff, self.m) if small else None
+        shown = _tidy(diff, self.m) if small else None
         named = f" by {inline(shown)}" if shown is not None and sp.count_ops(shown) <= 30 else ""
         fb.append(
             f"Your answer differs from the derived result{named}: a difference too small to "
@@ -638,7 +660,7 @@ class _Judge:
         """Why an answer the samples cannot fault is still not marked correct."""
         # an equation's difference is taken at one set of parameters' scale: not worth showing
         small = sp.count_ops(diff) <= PROOF_OPS and _expansion_size(diff, MAX_TERMS) <= MAX_TERMS
-        shown = tidy(diff, self.m) if not claim and small else None
+        shown = _tidy(diff, self.m) if not claim and small else None
         named = (
             f"the difference, {inline(shown)},"
             if shown is not None and sp.count_ops(shown) <= 30
@@ -703,7 +725,7 @@ class _Judge:
         sin, cos and q are positive, so abs(cos θ)/cos θ or sqrt(θ²) would pass there and be
         wrong at θ = −1 or θ = 2 (the pendulum's own start). A sentence naming a state where
         they part, or "" when none does."""
-        if constant and tidy(diff, self.m).is_number:
+        if constant and _tidy(diff, self.m).is_number:
             return ""
         rng = random.Random(1)
         positive = set(self.m.spec.positive_coordinates)
@@ -1073,12 +1095,21 @@ class _Judge:
         which every caller reads as 'too many terms'."""
         if _expansion_size(expr, 8 * MAX_TERMS) > 8 * MAX_TERMS:
             return {sp.Dummy(f"term{i}"): sp.S.One for i in range(MAX_TERMS + 1)}
-        e = sp.expand(sp.expand_trig(sp.expand(expr)))
+        # sin(10¹⁴ θ) expanded is a Chebyshev polynomial of degree 10¹⁴: such a function stays
+        # whole, one opaque factor of its monomial
+        hidden = {
+            f: sp.Dummy("trig")
+            for f in expr.atoms(sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+            if _huge_multiple(f)
+        }
+        e = sp.expand(sp.expand_trig(sp.expand(expr.xreplace(hidden))))
         e = sp.expand(TR5(e))
-        dynamic = set(self.m.q) | set(self.m.qd) | set(self.m.qdd) | {t}
+        dynamic = set(self.m.q) | set(self.m.qd) | set(self.m.qdd) | {t} | set(hidden.values())
+        shown = {v: k for k, v in hidden.items()}
         out: dict[sp.Expr, sp.Expr] = {}
         for term in sp.Add.make_args(e):
             coeff, mono = term.as_independent(*dynamic, as_Add=False)
+            mono = mono.xreplace(shown)
             out[mono] = out.get(mono, 0) + coeff
         if len(out) > MAX_TERMS:  # no term-by-term story to tell; simplifying each would take s
             return out
@@ -1118,7 +1149,7 @@ class _Judge:
         used: dict[sp.Expr, sp.Expr] = {}
         for velocity in dict.fromkeys([*map(self._velocity, e), *map(self._velocity, g)]):
             mine = sp.Add(*(c * k for k, c in g.items() if self._velocity(k) == velocity))
-            theirs = tidy(
+            theirs = _tidy(
                 sp.Add(*(c * k for k, c in e.items() if self._velocity(k) == velocity)), self.m
             )
             if zero_proof(mine - theirs, self.m) is True:
@@ -1207,8 +1238,8 @@ class _Judge:
         left out the cross term, or wrote cos(θ₁ + θ₂), should read about the term they wrote,
         l₁ l₂ m₂ cos(θ₁ − θ₂) θ̇₁ θ̇₂, not about its two halves. [] when the group does not
         tidy to a single term (the pieces are then compared one by one)."""
-        whole_e = tidy(sp.Add(*(c * k for k, c in e.items())), self.m)
-        whole_g = tidy(sp.Add(*(c * k for k, c in g.items())), self.m)
+        whole_e = _tidy(sp.Add(*(c * k for k, c in e.items())), self.m)
+        whole_g = _tidy(sp.Add(*(c * k for k, c in g.items())), self.m)
         if not e:
             if not g or whole_g.is_Add:
                 return []
@@ -1303,7 +1334,7 @@ class _Judge:
         'the l₁ l₂ m₂ cos(θ₁ − θ₂) θ̇₁ θ̇₂ term' rather than its expanded pieces. None when the
         terms do not pair up one to one (the canonical comparison then finds what differs)."""
         derived = [
-            self.scale * e for e in self._surface(tidy(self.expected, self.m, factor_whole=False))
+            self.scale * e for e in self._surface(_tidy(self.expected, self.m, factor_whole=False))
         ]
         written = self._surface(given)
         if not 1 < len(derived) <= 12 or len(written) != len(derived):
@@ -1347,7 +1378,7 @@ class _Judge:
         return " (a term carried across '=' changes its sign)"
 
     def _show(self, e: sp.Expr) -> str:
-        return inline(tidy(e, self.m))
+        return inline(_tidy(e, self.m))
 
     def _slips(self, given: sp.Expr, expected: sp.Expr) -> list[str]:
         """Typical slips: two parameters of the same units swapped, q mixed up with q̇."""

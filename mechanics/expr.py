@@ -147,7 +147,7 @@ def _exact_number(literal: str, value: object, field: str, position: int | None)
     except ArithmeticError:
         return number
     digits = decimal.normalize().as_tuple()
-    if len(digits.digits) > MAX_EXACT_DIGITS or not -330 <= decimal.adjusted() <= 308:
+    if len(digits.digits) > MAX_EXACT_DIGITS or not -1000 <= decimal.adjusted() <= 308:
         return number
     if decimal == decimal.to_integral_value() and abs(decimal) >= 10**MAX_DIGITS:
         return number  # 1e300 as an exact 10**300: what an integer literal may not write either

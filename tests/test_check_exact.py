@@ -9,6 +9,7 @@ with tomllib, factors evaluated in plain Python, identities settled with hand-bu
 from __future__ import annotations
 
 import math
+import time
 import tomllib
 from pathlib import Path
 
@@ -269,3 +270,18 @@ def test_an_l_with_a_wrong_term_in_the_motion_is_still_a_missing_term():
     v = check(d, "L", f"{L_DRIVEN} - m g A sin(w t) + t th")
     assert v.correct is False
     assert not any("function of t only" in line for line in v.feedback), v.feedback
+
+
+# -- bounded: a huge multiple inside a trig function -------------------------------------------
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("extra", ["sin(100000000000000 theta)", "cos(1e20 theta) theta_dot"])
+def test_a_huge_multiple_angle_is_judged_without_expanding_it(extra):
+    """sin(n θ) expanded is a polynomial of degree n in sin θ, cos θ (Chebyshev): for
+    n = 10¹⁴ sympy never finishes. The extra term is named as typed, quickly."""
+    started = time.perf_counter()
+    v = verdict("simple_pendulum", "T", f"1/2 m l^2 theta'^2 + {extra}")
+    assert time.perf_counter() - started < 10
+    assert v.correct is False and v.confirmed is True, v.feedback
+    assert any(line.startswith("Extra term") for line in v.feedback), v.feedback
