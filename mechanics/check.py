@@ -385,8 +385,9 @@ def _latex(d: Derivation, quantity: str, j: int | None) -> str:
 
 
 #: A rational whose denominator is past this (and a power of 2 and 5 only) came from a decimal
-#: the student typed, and is shown as one: 10^{-300}, not a fraction with 300 zeros.
-DECIMAL_DENOMINATOR = 10**6
+#: the student typed, and is shown as one: 10^{-300}, not a fraction with 300 zeros; 2.000001,
+#: not 2000001/1000000 (9.81 stays 981/100, as the derivations print it).
+DECIMAL_DENOMINATOR = 1000
 
 
 def to_latex(expr: sp.Expr) -> str:
