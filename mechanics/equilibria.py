@@ -90,6 +90,8 @@ class Verdict:
     vectors: list[np.ndarray] = field(default_factory=list)
     #: The family of equilibria it belongs to, in words (empty: an isolated point).
     family: str = ""
+    #: q0 is a pole of the coordinates: they cannot move in every direction there.
+    pole: bool = False
 
     @property
     def stable(self) -> bool:
@@ -198,6 +200,14 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 "defined there (a position function is not differentiable, or leaves its "
                 "domain, e.g. a square root at 0): the model does not hold at that point, so it "
                 "is left out."
+            )
+            continue
+        if verdict.pole and not _held_at_pole(d, variant, q0, values):
+            warnings.append(
+                f"Every Q_j vanishes at {_point_text(m, q0)}, a pole of the coordinates, only "
+                "because they cannot move in every direction there: beside it the forces do not "
+                "shrink to 0 (a force or torque acts along a direction they lose there), so it is "
+                "not an equilibrium and is left out."
             )
             continue
         verdict.family = root.family
@@ -1394,6 +1404,47 @@ def _stability(
     return verdict
 
 
+def _held_at_pole(d: Derivation, v: Variant, q0: list[float], values: dict) -> bool:
+    """Is a pole where every Q_j vanishes an equilibrium? There the coordinates lose a
+    direction, and Q_j = 0 can be their artefact: a top whose centre of mass is off its axis
+    has Q = 0 at θ = 0 (Euler angles) while gravity's torque about the lost axis acts. The size
+    of the force in the kinetic metric, Qᵀ M⁻¹ Q, must shrink to 0 as q0 is approached from
+    regular points (like ε² at a true equilibrium), not tend to a constant."""
+    m = v.model
+    psyms = tuple(sorted(values, key=str))
+    fn = _once(d, "forces at rest", (v.label, psyms), lambda: _rest_forces(v, psyms))
+    numbers = [float(values[p]) for p in psyms]
+    direction = np.random.default_rng(3).uniform(-1.0, 1.0, len(m.q))
+    sizes = []
+    for eps in (1e-3, 1e-5):
+        point = list(np.asarray(q0, dtype=float) + eps * direction)
+        with np.errstate(all="ignore"):
+            try:
+                M, f = (np.array(x, dtype=float) for x in fn(*point, *numbers))
+                sizes.append(float(f @ np.linalg.solve(M.reshape(len(f), len(f)), f)))
+            except (TypeError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+                return True  # nothing to judge by: keep it, with its pole caveats
+    far, near = sizes
+    if not (math.isfinite(far) and math.isfinite(near)):
+        return True
+    return near <= 1e-2 * abs(far) + 1e-300
+
+
+def _rest_forces(v: Variant, psyms: tuple) -> Callable[..., Any]:
+    """M and f at rest (q̇ = q̈ = 0, t = 0) as one numpy function of (q, parameters)."""
+    m = v.model
+    rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
+    xs = [sp.Dummy(f"q{j}") for j in range(len(m.q))]
+    to_x = dict(zip(m.q, xs, strict=True))
+
+    def at_rest(e: sp.Expr) -> sp.Expr:  # q̇, q̈ first: they hold q(t), which t = 0 would undo
+        return (sp.S.Zero + e).xreplace(rest).xreplace(to_x).xreplace({t: sp.S.Zero})
+
+    M = [at_rest(e) for e in v.mass_matrix]
+    f = [at_rest(e) for e in v.forcing]
+    return sp.lambdify([*xs, *psyms], [M, f], modules="numpy", dummify=True)
+
+
 def _singular(M: np.ndarray, tol: float) -> bool:
     """Is M singular relative to its own size (smallest singular value ≤ tol × largest)?"""
     s = np.linalg.svd(M, compute_uv=False)
@@ -1442,6 +1493,7 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     pole: θ 'radial') form with it a plane in which the motion is isotropic: each eigenvalue and
     mode that moves a radial coordinate comes twice. Otherwise the missing modes are unknown,
     and the verdict says so rather than show a short list."""
+    verdict.pole = True
     lost_names = ", ".join(m.coordinate_names[j] for j in lost)
     where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
     inertia = float(np.max(np.abs(full_M), initial=0.0))

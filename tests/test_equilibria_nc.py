@@ -285,3 +285,57 @@ def test_the_top_at_rest_falls_upright_and_swings_hanging(parameters):
             assert e["kind"] == "unstable"
             growth = sorted(z[0] for z in e["eigenvalues"])[-2:]
             assert growth == pytest.approx([math.sqrt(omega2)] * 2, rel=1e-9)
+
+
+def test_a_top_with_its_centre_of_mass_off_the_axis_rests_only_with_it_plumb_below_or_above():
+    """Euler angles z–x–z, gravity along −z, the centre of mass at (a, 0, h) in the body. At
+    θ = 0 every Q_j vanishes (the coordinates cannot turn about the axis they lose there), yet
+    gravity's torque m g a acts: no equilibrium. The true ones put G plumb below or above O,
+    at height z_G = h cos θ + a sin θ sin ψ = ∓d, d = √(a² + h²). Hanging, it swings as a
+    compound pendulum about O: about the body's y axis (⊥ OG) with I = I₁ + m d²; about
+    u = (h, 0, −a)/d with I_uu = (I₁h² + I₃a²)/d² + m d², lessened by its product of inertia
+    with the free spin about the vertical w = (a, 0, h)/d: I_uw = a h (I₁ − I₃)/d²,
+    I_ww = (I₁a² + I₃h²)/d², so I_eff = I_uu − I_uw²/I_ww. ω² = m g d/I for each."""
+    m, h, g, I1, I3, a = 1.0, 1.0, 1.0, 1.0, 0.5, 0.3
+    spec = top(I3=I3)
+    spec["parameters"]["a"] = a
+    spec["frames"] = [
+        {"name": "A", "parent": "N", "axis": "z", "angle": "phi"},
+        {"name": "B", "parent": "A", "axis": "x", "angle": "th"},
+        {"name": "C", "parent": "B", "axis": "z", "angle": "psi"},
+    ]
+    spec["bodies"][0]["position"] = {"frame": "C", "components": ["a", 0, "h"]}
+    spec["bodies"][0]["inertia"] = {"ixx": "I1", "iyy": "I1", "izz": "I3"}
+    spec["gravity"] = {"acceleration": "g", "direction": [0, 0, -1]}
+    result = solve(spec)
+    d = math.hypot(a, h)
+    assert result["equilibria"]
+    for e in result["equilibria"]:
+        th, psi = e["q"]["th"], e["q"]["psi"]
+        z = h * math.cos(th) + a * math.sin(th) * math.sin(psi)
+        assert abs(z) == pytest.approx(d, rel=1e-9), e["q"]  # plumb: none at θ = 0
+        if z < 0:
+            I_uu = (I1 * h**2 + I3 * a**2) / d**2 + m * d**2
+            I_uw, I_ww = a * h * (I1 - I3) / d**2, (I1 * a**2 + I3 * h**2) / d**2
+            inertias = [I1 + m * d**2, I_uu - I_uw**2 / I_ww]
+            expected = sorted(math.sqrt(m * g * d / i) for i in inertias)
+            assert e["kind"] == "stable" and e["frequencies"] == pytest.approx(expected)
+        else:
+            assert e["kind"] == "unstable"
+    assert any("pole of the coordinates" in w for w in result["warnings"])
+
+
+def test_a_spherical_pendulum_in_a_wind_does_not_rest_at_its_pole():
+    """A constant wind F x̂ on the bob: at θ = 0 with φ = ±π/2 both Q_θ = F l cos θ cos φ and
+    Q_φ = −F l sin θ sin φ vanish, but the wind still pushes the bob sideways. It rests only
+    where the string lines up with m g + F: tan θ = F/(m g) hanging, and the opposite way up."""
+    from mechanics.scenes import load_scene
+
+    spec = load_scene("spherical_pendulum")
+    spec["parameters"]["F"] = 2.0
+    spec["forces"] = [{"name": "wind", "on": spec["bodies"][0]["name"], "vector": ["F", 0, 0]}]
+    p = spec["parameters"]
+    result = solve(spec)
+    tilt = math.atan2(p["F"], p["m"] * p["g"])
+    thetas = sorted(abs(e["q"]["theta"]) for e in result["equilibria"])
+    assert thetas == pytest.approx([tilt, math.pi - tilt])
