@@ -102,6 +102,9 @@ class Trajectory:
     #: A fixed-step method's largest step (NaN for adaptive ones): the step actually taken, which
     #: is dt itself when the output times are whole multiples of dt apart.
     step: float = math.nan
+    #: The last state the stepping reached (at t_reached; None where the C or Fortran loop ran):
+    #: when a run stops, how large the state had grown tells a blow-up from stiffness.
+    y_reached: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         # Counters reach the JSON of a response: plain Python numbers, whatever counted them
@@ -120,7 +123,18 @@ _PHYSICAL = (ArithmeticError, np.linalg.LinAlgError)
 
 
 def _physical_stop(exc: BaseException, t: float) -> str:
-    return f"{type(exc).__name__} near t = {t:.6g} s: {exc}"
+    """What happened, in words (it reaches students as a warning): not "OverflowError (34,
+    'Numerical result out of range')"."""
+    if isinstance(exc, OverflowError):
+        return (
+            f"a step overflowed near t = {t:.6g} s: a number in the equations grew past the "
+            "range of a double (about 1e308)"
+        )
+    if isinstance(exc, ZeroDivisionError):
+        return f"the equations divided by zero near t = {t:.6g} s"
+    if isinstance(exc, np.linalg.LinAlgError):
+        return f"the mass matrix became singular near t = {t:.6g} s"
+    return f"an arithmetic error near t = {t:.6g} s ({exc})"
 
 
 def _beyond_doubles(exc: BaseException) -> bool:
@@ -189,6 +203,7 @@ class _Run:
     def __init__(self, y0: np.ndarray) -> None:
         self.out, self.nsteps, self.njev = [y0.copy()], 0, 0
         self.step = math.nan  # the largest fixed step taken
+        self.last: np.ndarray | None = None  # the last state stepped to (Python paths)
 
 
 def integrate(
@@ -279,6 +294,7 @@ def integrate(
         note,
         f.t if status != "ok" else float(t_eval[-1]),
         run.step,
+        run.last,
     )
 
 
@@ -340,6 +356,7 @@ def _fixed(run: _Run, step, f: _Counted, t_eval, dt, max_steps, n) -> None:
                 raise _Stop(f"step budget ({max_steps}) exhausted at t = {t0 + i * h:.6g} s")
             y = step(f, t0 + i * h, y, h, n)
             run.nsteps += 1
+            run.last = y
             if not _finite(y):
                 raise _Stop(f"state became non-finite at t = {t0 + (i + 1) * h:.6g} s")
             if f.watched(t0 + (i + 1) * h, y):
@@ -369,6 +386,7 @@ def _adaptive(run: _Run, cls, f: _Counted, y0, t_eval, rtol, atol, max_steps) ->
             solver.status = "failed"
             message = "the Jacobian is not finite (its entries overflow double precision)"
         run.njev = int(solver.njev)  # LSODA counts in a numpy int32
+        run.last = solver.y
         if solver.t == t_before and solver.status == "running":
             # LSODA at a blow-up reports "running" steps of size 0 (t stuck, y drifting) until a
             # budget runs out: no progress is a failure, blamed on a non-finite RHS if there was one

@@ -458,24 +458,12 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         overflow = _overflowed(c, params, req, run)
         if overflow is not None and len(run.t) <= 1:  # not one step: as a start that overflows
             raise SpecError([overflow])
-        warnings.append(f"The run stopped early: {run.message}. The trajectory is partial.")
+        said = run.message.rstrip(".")  # scipy's messages end in a full stop of their own
+        warnings.append(f"The run stopped early: {said}. The trajectory is partial.")
         if overflow is not None:
             warnings.append(overflow["message"][0].upper() + overflow["message"][1:] + ".")
-        if "wall-time" in run.message:  # out of time: stiffness, or a busy server
-            stiff = not METHODS[req.method].implicit and _looks_stiff(c, params, run)
-            warnings.append(
-                f"The run took longer than its {MAX_WALL_TIME:g} s of wall time"
-                + (
-                    ": its steps were held down by the fastest mode (a stiff system), where an "
-                    "explicit method needs tiny steps: try Radau or BDF."
-                    if stiff
-                    else " (the server may have been busy): try again, or ask for less (a "
-                    "shorter t_end, a looser rtol, dop853_c)."
-                )
-            )
-        elif "step" in run.message.lower() or "budget" in run.message.lower():
-            if not METHODS[req.method].implicit:
-                warnings.append("This looks stiff for an explicit method: try Radau or BDF.")
+        else:
+            warnings += _why_it_stopped(c, params, req, run)
     t, y = run.t, run.y
     n = c.n
     q, qd, w_nc = y[:, :n].T, y[:, n : 2 * n].T, y[:, 2 * n]
@@ -641,6 +629,108 @@ def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, lis
                     "pushes there, but a string would go slack and the motion would change."
                 )
     return out
+
+
+#: How much |T| + |V| must have grown, from the first half of a run to where it stopped, for a
+#: failed run to be told as a blow-up rather than as stiffness. Energy, not the size of the state:
+#: a stiff spring's velocity rises from 0 to ωx₀ within a step of its start, its energy stays.
+BLOW_UP_GROWTH = 1e6
+
+
+def _why_it_stopped(c: CompiledScene, params: list[float], req: Any, run: Trajectory) -> list[str]:
+    """Advice for a run that stopped early, from what the state did (values of ordinary size).
+
+    A solution that grows without bound (ẍ = −4x + 0.1ẋ³ blows up in finite time) makes an
+    adaptive solver's steps shrink to nothing, as stiffness does; told "try Radau or BDF" a
+    student would chase the wrong cause. Stiffness keeps the state bounded and makes h·ρ(J) of
+    order 1 (`_looks_stiff`); a blow-up makes the state's size explode. A fixed step that
+    overflows cannot tell a fast but finite motion (φ̇ near the pole of spherical coordinates)
+    from a blow-up: it says both, and how to find out.
+    """
+    text = run.message.lower()
+    explicit = not METHODS[req.method].implicit
+    t_stop = run.t_reached if math.isfinite(run.t_reached) else float(run.t[-1])
+    ran_away = "overflow" in text or "non-finite" in text
+    if METHODS[req.method].kind == "fixed" and ran_away:
+        return [
+            f"With a fixed step of dt = {req.dt:g} s the state ran away within a step near "
+            f"t = {t_stop:.4g} s. That happens where the motion is fast for the step (near a "
+            "coordinate singularity, like θ = 0 of spherical coordinates where φ̇ is large) or "
+            "where the solution itself grows without bound: try a smaller dt, or an adaptive "
+            "method (DOP853), which shrinks its steps where the motion is fast and tells the two "
+            "apart."
+        ]
+    growth = _growth(c, params, req, run)
+    if growth is not None:
+        before, after = growth
+        return [
+            f"The solution grows without bound: |T| + |V| went from {before:.3g} (first half "
+            f"of the run) to {after:.3g} at t = {t_stop:.4g} s, where the steps "
+            "shrank to nothing. That is a blow-up in finite time, the equations' own motion and "
+            "not stiffness: no method or tolerance carries it further (look for a force that "
+            "feeds energy in faster than the motion grows, like + c·ẋ³)."
+        ]
+    if "wall-time" in text:  # out of time: stiffness, or a busy server
+        stiff = explicit and _looks_stiff(c, params, run)
+        return [
+            f"The run took longer than its {MAX_WALL_TIME:g} s of wall time"
+            + (
+                ": its steps were held down by the fastest mode (a stiff system), where an "
+                "explicit method needs tiny steps: try Radau or BDF."
+                if stiff
+                else " (the server may have been busy): try again, or ask for less (a "
+                "shorter t_end, a looser rtol, dop853_c)."
+            )
+        ]
+    if "budget" in text or "step size" in text or "too small" in text:
+        if explicit and _looks_stiff(c, params, run):
+            return ["This looks stiff for an explicit method: try Radau or BDF."]
+        if "budget" in text:
+            return ["The run used up its steps: ask for less (a shorter t_end, a looser rtol)."]
+        return [
+            f"The solver's steps shrank to nothing near t = {t_stop:.4g} s while the state "
+            "stayed bounded: the equations are not smooth there (a discontinuity such as "
+            "friction reversing, or a singularity of the coordinates)."
+        ]
+    return []
+
+
+def _growth(c: CompiledScene, params: list[float], req: Any, run: Trajectory):
+    """(|T| + |V| before, at the stop) when it grew BLOW_UP_GROWTH-fold from the first half of
+    the run to where the stepping stopped; else None. The C loop keeps no state past its
+    last sample: the stretch from there to the stop is stepped again (scipy's DOP853)."""
+    n2 = 2 * c.n
+    end = run.y_reached
+    t_last, reached = float(run.t[-1]), run.t_reached
+    if end is None and math.isfinite(reached) and reached > t_last:
+        try:
+            again = integrate(
+                c.rhs(params),
+                run.y[-1],
+                np.array([t_last, reached]),
+                method="DOP853",
+                rtol=req.rtol,
+                atol=req.atol,
+                max_wall_time=1.0,
+                second_order=c.n,
+            )
+            end = again.y_reached
+        except (ValueError, *_PHYSICAL):
+            end = None
+    end = np.asarray(run.y[-1] if end is None else end, dtype=float)
+    early = run.t <= (reached if math.isfinite(reached) else t_last) / 2
+
+    def size(t: np.ndarray, y: np.ndarray) -> np.ndarray:
+        with np.errstate(all="ignore"):
+            T, V = evaluate(c.energy, t, y[:, : c.n].T, y[:, c.n : n2].T, params)
+        return np.abs(T) + np.abs(V)
+
+    before = float(np.max(size(run.t[early], run.y[early])))
+    at = reached if math.isfinite(reached) else t_last
+    after = float(size(np.array([at]), end[None, :])[0])
+    if math.isnan(after) or not after > BLOW_UP_GROWTH * max(before, 1e-300):
+        return None
+    return before, after
 
 
 def _looks_stiff(c: CompiledScene, params: list[float], run: Any) -> bool:

@@ -119,3 +119,55 @@ def test_adaptive_runs_keep_the_fps_grid(client):
     out = run(client, method="DOP853", t_end=1, fps=30, check_sensitivity=False)
     assert len(out["t"]) == 31 and out["stats"]["sample_interval"] == pytest.approx(1 / 30)
     assert "dt" not in out["stats"] or out["stats"]["dt"] is None
+
+
+BLOW_UP = {
+    "title": "Spring with a cubic push",
+    "coordinates": ["x"],
+    "parameters": {"m": 1.0, "k": 4.0, "c": 0.1},
+    "bodies": [{"name": "b", "mass": "m", "position": ["x", 0, 0]}],
+    "springs": [{"a": "O", "b": "b", "k": "k"}],
+    "forces": [{"on": "b", "vector": ["c*x_dot**3", 0, 0]}],
+    "initial": {"x": 0.5},
+}
+
+
+def test_a_finite_time_blow_up_is_told_as_one_not_as_stiffness(client):
+    """ẍ = −4x + 0.1ẋ³ feeds energy in faster than it grows: integrated here with scipy, |ẋ|
+    passes 1e5 before t = 14 s. The run must say the solution grows without bound, and must not
+    send the student to Radau or BDF for a stiffness that is not there."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(t, y):
+        return [y[1], -4 * y[0] + 0.1 * y[1] ** 3]
+
+    def big(t, y):
+        return abs(y[1]) - 1e5
+
+    big.terminal = True
+    mine = solve_ivp(rhs, (0, 20), [0.5, 0.0], rtol=1e-10, atol=1e-12, events=big)
+    assert mine.status == 1 and mine.t_events[0][0] < 14  # it does blow up
+    for method in ("DOP853", "dop853_c", "RK45"):
+        r = client.post(
+            "/api/v1/simulate",
+            json={"scene": BLOW_UP, "method": method, "t_end": 20, "fps": 30},
+        ).json()
+        assert r["stats"]["status"] == "stopped"
+        text = " ".join(r["warnings"])
+        assert "grows without bound" in text and "Radau" not in text, (method, r["warnings"])
+        assert r["t"][-1] <= mine.t_events[0][0] + 0.1
+
+
+def test_an_overflowing_fixed_step_says_so_in_words(client):
+    """rk4 at dt = 0.01 heading for the spherical pendulum's pole: φ̇ = p/sin²θ is huge there and
+    the fixed step overflows; an adaptive run of the same start goes through (the motion is
+    finite), so the words must name the step, not a Python error."""
+    initial = {"theta": 0.5, "theta_dot": -3, "phi_dot": 0.01}
+    body = {"scene_id": "spherical_pendulum", "initial": initial, "t_end": 3}
+    fixed = run(client, **body, method="rk4", dt=0.01)
+    adaptive = run(client, **body, method="DOP853", check_sensitivity=False)
+    assert adaptive["stats"]["status"] == "ok"
+    assert fixed["stats"]["status"] == "stopped"
+    text = " ".join(fixed["warnings"])
+    assert "OverflowError" not in text and "34" not in text
+    assert "smaller dt" in text and "adaptive" in text
