@@ -160,8 +160,15 @@ class WorkerPool:
         free; ``what`` names the work and ``advice`` says what to do past the time budget, in the
         messages a person reads ("deriving this scene took longer than 20 s; ...").
         """
-        deadline = time.monotonic() + seconds
+        asked = time.monotonic()
+        deadline = asked + seconds
         slot = self._admit(client, affinity, deadline, seconds)
+        waited = time.monotonic() - asked
+        if waited > seconds / 4:  # past the budget, the queue is the cause, not the work
+            advice = (
+                f"{waited:.1f} s of the {seconds:g} went waiting for a free worker (the server "
+                "was busy): try again shortly"
+            )
         try:
             return self._execute(slot, (fn, args, kwargs), deadline, seconds, what, advice)
         finally:
@@ -258,8 +265,14 @@ class WorkerPool:
         return self._free[0]
 
     def _busy_message(self, client: str, seconds: float) -> str:
+        queued = sum(1 for _, c in self._waiting if c == client) - 1  # besides this one
         return busy_message(
-            self._running[client], self.per_client, seconds, "request", "no worker was free"
+            self._running[client],
+            self.per_client,
+            seconds,
+            "request",
+            "no worker was free",
+            queued=max(0, queued),
         )
 
     def _release(self, slot: _Slot, client: str) -> None:
@@ -384,12 +397,17 @@ def _exit_with_server(lifeline: Connection) -> None:
             pass
 
 
-def busy_message(mine: int, per_client: int, seconds: float, what: str, busy: str) -> str:
+def busy_message(
+    mine: int, per_client: int, seconds: float, what: str, busy: str, queued: int = 0
+) -> str:
     """Why a job could not start in time, in words that tell the client what to do: its own
-    queue (wait for its answers) or the server's (try again shortly)."""
+    queue (wait for its answers) or the server's (try again shortly). ``queued`` counts the
+    client's other jobs still waiting: ten sent at once read "1 running" while nine waited."""
     if mine >= per_client:
+        waiting = f" and {queued} more waiting" if queued else ""
         return (
-            f"you already have {mine} {what}{'s' if mine > 1 else ''} running and this one "
-            f"could not start within {seconds:g} s; wait for the answers, then try again"
+            f"you already have {mine} {what}{'s' if mine > 1 else ''} running (a client gets "
+            f"{per_client} at a time){waiting}, and this one could not start within "
+            f"{seconds:g} s; wait for the answers, then try again"
         )
     return f"the server is busy: {busy} within {seconds:g} s; try again shortly"
