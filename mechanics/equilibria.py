@@ -1243,7 +1243,7 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
         leaky = True
     text = to_plain(power)
     if leaky:
-        return Power("no sign", "a damper with c < 0")
+        return Power("no sign", "−c ℓ̇² of a damper with c < 0")
     if not moves:
         return Power("dissipative" if dampers else "none")
     at = sp.expand(power.xreplace(values)) if power != 0 else power
