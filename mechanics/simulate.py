@@ -120,8 +120,7 @@ def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float]
     if errors:
         raise SpecError(errors)
     values = {**spec.parameters, **req.parameters}
-    if req.parameters:  # the spec's own values were checked when its model was built
-        errors += physical_limit_errors(c.derivation.model, values)
+    errors += physical_limit_errors(c.derivation.model, values)  # at these values, not the spec's
     init = {**spec.initial, **req.initial}
     for q in spec.positive_coordinates:
         if init.get(q, 0.0) <= 0:
