@@ -207,3 +207,13 @@ def test_a_start_at_a_domain_end_names_the_coordinate_not_the_units(client, th):
 
 def test_inside_the_domain_the_root_curve_runs(client):
     assert simulate(client, ROOT).status_code == 200
+
+
+def test_the_derivation_refuses_the_same_limits(client):
+    """/derive builds the model at the spec's own values: the refusal is there too."""
+    spec = with_(SPRING, ("springs", 0, "k"), "k - 3")
+    r = client.post("/api/v1/derive", json={"scene": spec})
+    assert fields(r) == ["springs[0].k"]
+    rod = with_(ROD, ("bodies", 0, "inertia"), {"ixx": 0, "iyy": 0, "izz": -0.5})
+    r = client.post("/api/v1/derive", json={"scene": rod})
+    assert fields(r) == ["bodies[0].inertia.izz"]
