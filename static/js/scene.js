@@ -267,6 +267,7 @@ class SceneView {
       $("canvas").dataset.lastQ = JSON.stringify(last);
       $("canvas").dataset.run = String(id);
       showStop([a, b]);
+      if (!this.playing) this.#toSample(); // a new run's samples may lie elsewhere (another dt)
       this.fbd(true);
       // The plots after the motion's next frame is painted: plotly's first drawing takes a few
       // hundred ms of the main thread, which the animation should not wait behind.

@@ -236,6 +236,18 @@ def test_the_paused_free_body_diagram_shows_the_clocks_instant(server, page):
         p.keyboard.press(key)
         p.wait_for_timeout(150)
         assert fbd_time(p) == p.inner_text("#clock"), key
+    # a new run on another grid of samples (rk4 at dt = 0.05 s: 20 a second) while paused
+    run = p.get_attribute("#canvas", "data-run")
+    p.select_option("#method", "rk4")
+    p.select_option("#dt", "0.05")
+    p.wait_for_function(
+        "(n) => document.querySelector('#canvas').dataset.run !== n", arg=run, timeout=60_000
+    )
+    page.settle()
+    p.wait_for_timeout(200)
+    assert fbd_time(p) == p.inner_text("#clock")
+    p.select_option("#method", "dop853_c")  # the session page's next test gets the default
+    page.settle()
     assert page.errors == []
 
 
