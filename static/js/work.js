@@ -72,13 +72,13 @@ export function showWork(run, { lecture = false } = {}) {
   cueScrolling(table);
   if (typeof window.Plotly === "undefined") return;
   const ink = lecture ? "#f1f3f5" : "#1d2430";
-  const base = { margin: { l: lecture ? 76 : 60, r: 12, t: lecture ? 64 : 48, b: lecture ? 70 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
-    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 24 : 12 },
+  const base = { margin: { l: 60, r: 12, t: lecture ? 60 : 48, b: lecture ? 64 : 52 }, paper_bgcolor: "rgba(0,0,0,0)",
+    plot_bgcolor: "rgba(0,0,0,0)", font: { color: ink, size: lecture ? 20 : 12 },
     // the legend at the figure's foot (container coordinates): plotly then makes room for it
     // under the axis title, which a legend placed below the plot area (paper y < 0) would cover
     legend: { orientation: "h", yref: "container", yanchor: "bottom", y: 0, x: 0 } };
   // titles of one short line: plotly clips a title longer than its plot, and a second line too
-  const title = (text) => ({ text, font: { size: lecture ? 24 : 14 }, x: 0.02, xanchor: "left" });
+  const title = (text) => ({ text, font: { size: lecture ? 22 : 14 }, x: 0.02, xanchor: "left" });
   const top = () => base.margin;
   const span = t.slice(i, j + 1);
   const traces = Object.entries(run.work.non_conservative).map(([k, w]) => ({
@@ -99,7 +99,7 @@ export function showWork(run, { lecture = false } = {}) {
     const r = Math.max(energy, 1e-12) * 0.1;
     Object.assign(yaxis, { range: [-r, r], autorange: false });
     annotations.push({ text: `W<sup>NC</sup> = ΔT + ΔV = 0 within rounding<br>(largest |value| ${largest.toExponential(1)} J)`, showarrow: false,
-      xref: "paper", yref: "paper", x: 0.5, y: 0.62, font: { size: lecture ? 24 : 14, color: ink } });
+      xref: "paper", yref: "paper", x: 0.5, y: 0.62, font: { size: lecture ? 22 : 14, color: ink } });
   }
   $("plot-work").dataset.rounding = rounding ? "1" : "0";
   const workTitle = driven ? "W of forces and drive (stacked), ΔT + ΔV"
