@@ -18,6 +18,7 @@ import sympy as sp
 
 from mechanics.derive import Derivation
 from mechanics.expr import FUNCTIONS, MAX_LENGTH, ExprError, parse
+from mechanics.model import T
 
 GREEK = {
     "θ": "theta", "ϑ": "theta", "φ": "phi", "ϕ": "phi", "ψ": "psi", "ω": "omega", "Ω": "Omega",
@@ -104,6 +105,9 @@ def to_convention_mapped(
     text, origin = _normalise(text)
     origin.append(len(typed))
     out: list[tuple[str, str, int]] = []  # (kind, text, where it was typed)
+    power = None  # sin^2 seen: (its exponent, where), waiting for the argument
+    closes: list[tuple[int, str, int]] = []  # (depth, exponent, where): sin^2( ... ) ** 2
+    depth = 0
     pos = 0
     while pos < len(text):
         m = _TOKEN.match(text, pos)
@@ -128,6 +132,28 @@ def to_convention_mapped(
             continue
         if kind == "op" and value == "^":
             value = "**"
+        at = origin[m.start()]
+        if power == "":  # sin^ was the last thing: a whole number must come
+            if kind != "num" or not value.isdigit():
+                raise ExprError(_FUNCTION_POWER, field=field, position=at)
+            power = (value, at)
+            continue
+        if kind == "op" and value == "**" and out and out[-1][0] == "name":
+            if out[-1][1] in FUNCTIONS:  # sin^2(θ), sin^2 θ: the notes' sin²θ is sin(θ)^2
+                power = ""
+                continue
+        if power is not None:
+            if value == "(":
+                closes.append((depth, *power))
+            elif kind not in ("num", "name"):
+                raise ExprError(_FUNCTION_POWER, field=field, position=at)
+        if kind == "name" and _is_time_derivative(out, value, typed, known):
+            if text[m.end() :].lstrip()[:1] != "(":
+                raise ExprError(_DDT_PARENTHESES, field=field, position=origin[m.start()])
+            out.pop()
+            at = out.pop()[2]
+            _append(out, "name", DDT, at)
+            continue
         if kind == "name" and value == "dt" and "dt" not in known and _leibniz(out, typed):
             out.pop()  # dtheta/dt: the '/' goes, dtheta already reads theta_dot
             continue
@@ -136,10 +162,27 @@ def to_convention_mapped(
                 pieces = _resolve(value, coordinates, known, vocabulary)
             except ExprError as exc:
                 raise ExprError(exc.message, field=field, position=origin[m.start()]) from None
-            for piece in pieces:
+            for k, piece in enumerate(pieces):
                 _append(out, "name", piece, origin[m.start()])
+                if k == 0 and power is not None and power != "":  # sin^2 θ: sin(θ) ** 2
+                    out += [("op", "**", power[1]), ("num", power[0], power[1])]
+                    power = None
             continue
         _append(out, kind, value, origin[m.start()])
+        if kind == "num" and power is not None:  # sin^2 3: the one atom taken
+            out += [("op", "**", power[1]), ("num", power[0], power[1])]
+            power = None
+        elif value == "(":
+            depth += 1
+            if power is not None:
+                power = None  # its closing ')' carries the power (closes)
+        elif value == ")":
+            depth -= 1
+            if closes and closes[-1][0] == depth:
+                _, exponent, where_typed = closes.pop()
+                out += [("op", "**", where_typed), ("num", exponent, where_typed)]
+    if power is not None:
+        raise ExprError(_FUNCTION_POWER, field=field, position=len(typed))
     result: list[str] = []
     where: list[int] = []
     for k, (_, value, at) in enumerate(out):
@@ -150,6 +193,34 @@ def to_convention_mapped(
         where += [at] * len(value)
     where.append(len(typed))
     return "".join(result), where
+
+
+_FUNCTION_POWER = (
+    "write sin^2(theta) (or sin(theta)^2) for the square of sin θ: after sin^ comes a whole "
+    "number, then the argument; the inverse is asin(...), the reciprocal 1/sin(...)"
+)
+_DDT_PARENTHESES = (
+    "d/dt needs its expression in parentheses: d/dt(m l^2 theta'), or write the derivative "
+    "out with theta' and theta''"
+)
+#: The token a typed `d/dt(` becomes: read_answer differentiates what its parentheses hold.
+DDT = "d_dt"
+#: Past this size (count_ops) the expression under d/dt is not differentiated: the product rule
+#: on a long product is quadratic in its length.
+MAX_DDT_OPS = 200
+#: At most this many d/dt(...) in one answer (each is a parse and a derivative).
+MAX_DDT = 8
+
+
+def _is_time_derivative(out: list[tuple[str, str, int]], value: str, typed: str, known) -> bool:
+    """Is the text so far `d /` and this name `dt`: the operator d/dt (typed as such, a lone
+    d, even where d is a length: d/dt is never d divided by d t)?"""
+    if value != "dt" or "dt" in known or DDT in known or len(out) < 2:
+        return False
+    if out[-1][:2] != ("op", "/") or out[-2][:2] != ("name", "d"):
+        return False
+    at = out[-2][2]
+    return typed[at : at + 1] == "d" and (at == 0 or not typed[at - 1].isalnum())
 
 
 def _leibniz(out: list[tuple[str, str, int]], typed: str) -> bool:
@@ -183,7 +254,11 @@ def _append(out: list[tuple[str, str, int]], kind: str, value: str, at: int) -> 
         return
     if out:
         prev_kind, prev, _ = out[-1]
-        left = prev_kind == "num" or prev == ")" or (prev_kind == "name" and prev not in FUNCTIONS)
+        left = (
+            prev_kind == "num"
+            or prev == ")"
+            or (prev_kind == "name" and prev not in FUNCTIONS and prev != DDT)
+        )
         right = kind in ("num", "name") or value == "("
         if left and right:
             out.append(("op", "*", at))
@@ -241,6 +316,7 @@ def read_answer(
                     message = message.replace("'**'", "'^'")
             raise _pointed(message, answer, at) from None
 
+    text, names = _time_derivatives(text, where, names, read, answer, model)
     if "=" not in text:
         return read(0, len(text)), sp.S.Zero
     equals = text.index("=")
@@ -263,6 +339,61 @@ def read_answer(
         return (rhs if lhs == qdd else lhs), sp.S.Zero
     name = model.coordinate_names[j]
     raise _pointed(f"write q̈ as '{name}_ddot = ...'", answer, where[equals])
+
+
+def _time_derivatives(
+    text: str, where: list[int], names: dict[str, sp.Expr], read, typed: str, model
+) -> tuple[str, dict[str, sp.Expr]]:
+    """Each `d/dt( … )` of the answer replaced by the total time derivative of what it holds
+    (∂/∂q q̇ + ∂/∂q̇ q̈ + ∂/∂t: q is q(t) here, so sympy's d/dt is exactly that), bound to a
+    name of the same length in the text, so every later position still points where it did.
+    The expression inside is read by the same parser, and bounded before it is differentiated.
+    """
+    found = [m.start() for m in re.finditer(rf"\b{DDT} \(", text)]
+    if not found:
+        return text, names
+    if len(found) > MAX_DDT:
+        raise _pointed(f"at most {MAX_DDT} d/dt(...) in one answer", typed, where[found[-1]])
+    names = dict(names)
+    spans = []
+    for start in found:
+        open_at = start + len(DDT) + 1
+        level, close = 0, None
+        for k in range(open_at, len(text)):
+            level += {"(": 1, ")": -1}.get(text[k], 0)
+            if level == 0:
+                close = k
+                break
+        if close is None:
+            raise _pointed("'(' after d/dt is never closed", typed, where[open_at])
+        if spans and start < spans[-1][1]:
+            raise _pointed(
+                "d/dt inside d/dt: write a second derivative with theta''", typed, where[start]
+            )
+        spans.append((start, close + 1))
+    out = list(text)
+    for k, (start, end) in enumerate(spans):
+        inner = read(start + len(DDT) + 2, end - 1)
+        if any(inner.has(a) for a in model.qdd):
+            raise _pointed(
+                "d/dt of an acceleration is a third derivative, which no answer here needs",
+                typed,
+                where[start],
+            )
+        derivative = sp.diff(inner, T) if sp.count_ops(inner) <= MAX_DDT_OPS else None
+        if derivative is None or sp.count_ops(derivative) > 2 * MAX_DDT_OPS:
+            raise _pointed(
+                "the expression under d/dt is too long to differentiate here: write its "
+                "derivative out",
+                typed,
+                where[start],
+            )
+        name = f"ddt{k}_"
+        while name in names:
+            name += "_"
+        names[name] = derivative
+        out[start:end] = list(name.ljust(end - start))
+    return "".join(out), names
 
 
 def _pointed(message: str, typed: str, at: int | None) -> ExprError:

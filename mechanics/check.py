@@ -24,6 +24,7 @@ from sympy.simplify.fu import TR5
 from mechanics import units
 from mechanics.answers import read_answer
 from mechanics.derive import Derivation
+from mechanics.expr import parse
 from mechanics.expr import to_latex as _latex_of
 from mechanics.model import T as t
 from mechanics.spec import SpecError
@@ -59,6 +60,16 @@ NEAR_MISS = 1e-6
 #: MAX_TRIG_MULTIPLE): sin(10¹⁴ θ) expanded would never finish.
 MAX_CANONICAL_MULTIPLE = 64
 NEAR_MISS_DENOMINATOR = 1000
+
+
+def _never_zero(factor: sp.Expr) -> bool:
+    """Is ``factor`` a number times powers of parameters (1/(m l²)), which no parameter value
+    but 0 makes vanish? (m₁ − m₂)/(m₁ + m₂) is 0 at m₁ = m₂: scaling by it hides the equation."""
+    for part in sp.Mul.make_args(sp.factor(factor)):
+        base = part.as_base_exp()[0]
+        if not (base.is_number or base.is_Symbol):
+            return False
+    return factor != 0
 
 
 #: How a verdict that no proof could settle begins (`Verdict.confirmed`).
@@ -375,6 +386,11 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
     return verdict
 
 
+def _parse_position(text: str, model: Any) -> sp.Expr:
+    """A position component from the scene's file, read by the same whitelist parser."""
+    return parse(text, model.names, field="position")
+
+
 def _latex(d: Derivation, quantity: str, j: int | None) -> str:
     w, m = d.work, d.model
     if quantity == "eom":
@@ -566,7 +582,73 @@ class _Judge:
             return
         if q == "L" and self._time_only(self.given - self.expected, fb):
             return
+        if q == "Q" and self._conservative_part(fb):
+            return
+        if q in ("V", "L") and self._shifted_datum(fb):
+            return
         self._diagnose(self.given, self.expected, fb)
+
+    def _conservative_part(self, fb: list[str]) -> bool:
+        """A Q_j that is Q_j^NC plus −∂V/∂q_j: the notes' eq. 31 sums every force, gravity and
+        springs included, but the forces step asks only for the non-conservative part (the
+        rest is in V). Saying 'Extra term' would hide that the student's physics is right;
+        it is still not the quantity asked for. Proved, not sampled."""
+        q = self.m.q[self.j]
+        conservative = -partial(self.d.work.V, q, self.m)
+        if conservative == 0:
+            return False
+        rest = self.given - self.expected - conservative
+        if not self.same(rest, sp.S.Zero) or zero_proof(rest, self.m) is not True:
+            return False
+        spec = self.m.spec
+        sources = [w for w, has in (("gravity", spec.gravity), ("springs", spec.springs)) if has]
+        name = to_latex(q)
+        shown = inline(_tidy(conservative, self.m))[1:-1]
+        fb.append(
+            f"Your answer includes the conservative part $-\\partial V/\\partial {name} = "
+            f"{shown}$ ({'/'.join(sources) or 'gravity/springs'}), which is already in V: only "
+            f"the non-conservative part $Q_{{{name}}}^{{NC}}$ is asked for"
+            + ("." if self.expected == 0 else "; without that part your answer would be right.")
+        )
+        return True
+
+    def _shifted_datum(self, fb: list[str]) -> bool:
+        """A spring's V written k (x − L0)²/2 (the notes' eq. 27, stretch = length − rest
+        length) in a scene whose x is already measured from the rest length (the block at
+        L0 + x): the 'Extra term −L0 k x' it gives is true but hides why. Said when the answer
+        with x − L0 put back to x is the derived one (up to a constant, for V and L)."""
+        spec = self.m.spec
+        rests = {s.rest_length for s in spec.springs if isinstance(s.rest_length, str)}
+        for name, q in zip(self.m.coordinate_names, self.m.q, strict=True):
+            for rest in sorted(rests):
+                length = self.m.params.get(rest)
+                where = self._measured_from(name, rest)
+                if length is None or not where:
+                    continue
+                shifted = self.given.xreplace({q: q + length})
+                if not self._constant(shifted - self.expected):
+                    continue
+                x, x0 = to_latex(q), to_latex(length)
+                fb.append(
+                    f"In this scene ${x}$ is measured from the spring's rest length ({where}), "
+                    f"so the spring's stretch is ${x}$ itself, not ${x} - {x0}$: your answer is "
+                    f"the derived one with ${x} - {x0}$ in place of ${x}$."
+                )
+                return True
+        return False
+
+    def _measured_from(self, coordinate: str, rest: str) -> str:
+        """'the block sits at L0 + x': a body whose position the scene writes with both the
+        coordinate and the rest length, as the scene's file has it; "" if none does."""
+        names = {coordinate, rest}
+        for body in self.m.spec.bodies:
+            position = body.position
+            parts = position if isinstance(position, list) else position.components
+            for part in parts:
+                if isinstance(part, str) and names <= set(re.findall(r"[A-Za-z_]\w*", part)):
+                    shown = to_latex(_parse_position(part, self.m))
+                    return f"the {body.name} sits at ${shown}$"
+        return ""
 
     def _time_only(self, diff: sp.Expr, fb: list[str]) -> bool:
         """An L that differs from T − V by a function of t alone (a driven support's
@@ -617,6 +699,16 @@ class _Judge:
         undefined = self._undefined_at_parameters(self.given)
         if undefined:
             fb.append(undefined)
+            return
+        datum = constant and zero_proof(diff, self.m) is not True
+        wrong_units = self._units(self.given) if datum else []
+        if wrong_units:  # + m on V is no datum: kg is not an energy (T + m is refused alike)
+            fb.append(
+                f"Your {self.quantity} differs from the derived one by a constant, which would "
+                "only move the datum, but that constant must be an energy like the rest of "
+                f"{self.quantity}:"
+            )
+            fb += wrong_units
             return
         verdict.correct = True
         fb.append(
@@ -781,9 +873,22 @@ class _Judge:
     def _eom(self, verdict: Verdict) -> None:
         fb = verdict.feedback
         given, expected = self.given, self.expected
-        if not any(given.has(a) for a in self.m.qdd):
+        if given == 0 or (
+            not any(given.has(a) for a in self.m.qdd) and zero_proof(given, self.m) is True
+        ):
             fb.append(
-                "An equation of motion must contain an acceleration "
+                "Your equation reduces to 0 = 0 (an identity): its terms cancel, so it holds "
+                "for every motion and determines nothing. An equation of motion must keep "
+                f"{inline(self.m.qdd[self.j])}."
+            )
+            return
+        if not any(given.has(a) for a in self.m.qdd):
+            typed = any((given + self.moved).has(a) or self.moved.has(a) for a in self.m.qdd)
+            fb.append(
+                "The accelerations in your equation cancel between its two sides: what is left "
+                f"has no {inline(self.m.qdd[self.j])}, and an equation of motion must keep one."
+                if typed
+                else "An equation of motion must contain an acceleration "
                 f"({inline(self.m.qdd[self.j])}); yours has none."
             )
             self._diagnose(given, expected, fb)
@@ -816,8 +921,10 @@ class _Judge:
             self._how_it_holds(given, expected, fb)
             if fb:
                 return
+        if self._inertia_only(given, expected, fb):
+            return
         scale = self._scaling(given, expected)
-        if scale is not None and scale != 1:
+        if scale is not None and scale != 1 and _never_zero(scale):
             # compare with the derived equation as the student scaled it, so the feedback names
             # their own terms (g/l sin θ), not the derived equation's (m g l sin θ)
             fb.append(
@@ -828,6 +935,33 @@ class _Judge:
             self.scale = scale
         self.reference = expected
         self._diagnose(given, expected, fb)
+
+    def _inertia_only(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> bool:
+        """An equation whose force terms are the derived ones (times a number) and whose q̈_j
+        coefficient is not: the error is the inertia ((m₁ − m₂) ẍ for (m₁ + m₂) ẍ). Reading it
+        as the derived equation scaled to match the q̈ term would blame the forces instead,
+        and by a factor that can vanish (m₁ = m₂)."""
+        qdd = self.m.qdd[self.j]
+        mine, theirs = partial(given, qdd, self.m), partial(expected, qdd, self.m)
+        if theirs == 0 or mine.has(qdd) or theirs.has(qdd):
+            return False
+        forces = self._ratio(given - mine * qdd, expected - theirs * qdd)
+        if forces in (None, 0) or not forces.is_Rational:
+            return False
+        right = _tidy(forces * theirs * qdd, self.m)
+        wrong = _tidy(mine * qdd, self.m)
+        if sp.count_ops(right) > 30 or sp.count_ops(wrong) > 30:
+            return False
+        if self._ratio(mine, theirs) is not None:
+            return False  # a q̈ term off by a number fits a scaling: the forces are then off
+        how = f"you have {inline(wrong)} where {inline(right)} belongs"
+        scaled = "" if forces == 1 else f" (as the derived equation times {inline(forces)})"
+        fb.append(
+            f"The forces in your equation are right{scaled}, but the inertia term "
+            f"(the {inline(qdd)} term) is not: {how}. Its coefficient is the inertia every "
+            "force on the system has to accelerate."
+        )
+        return True
 
     def _how_it_holds(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> None:
         """An equation that is not a multiple of the derived one, read at the samples: the
@@ -1074,8 +1208,12 @@ class _Judge:
             )
         else:
             paired = self._paired(given)
-            fb += self._terms(given, expected) if paired is None else paired
-            fb += self._slips(given, expected)
+            terms = self._terms(given, expected) if paired is None else paired
+            slips = self._slips(given, expected)
+            if terms and all(line.startswith("Sign error") for line in terms):
+                # (m₂ − m₁) g for (m₁ − m₂) g is the swap and the sign error at once: one story
+                slips = [line for line in slips if "are swapped" not in line]
+            fb += terms + slips
         fb += self._units(given)
         if not fb:
             fb.append("Not equal to the derived result at the states sampled.")
@@ -1472,8 +1610,8 @@ class _Judge:
         # of them: a hostile (a + b + …)**30 must not become thousands of lines
         wrong = []
         for term in self._surface(given):
-            if term == 0 or (term.is_number and self.quantity in ("V", "L")):
-                continue  # "0" has every unit; a datum's number has V's (5 J: no unit typed)
+            if term == 0:
+                continue  # "0" has every unit; a bare number is dimensionless, in V as in T
             have = units.dimension(term, dims)
             if have != want:
                 wrong.append((term, have))

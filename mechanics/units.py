@@ -67,7 +67,8 @@ def fmt(dim: Dim) -> str:
             (top if e > 0 else bottom).append(part)
     if not (top or bottom):
         return "dimensionless"
-    return ("·".join(top) or "1") + ("/" + "·".join(bottom) if bottom else "")
+    below = "·".join(bottom) if len(bottom) < 2 else f"({'·'.join(bottom)})"  # 1/(m·s²)
+    return ("·".join(top) or "1") + ("/" + below if bottom else "")
 
 
 def dimension(expr: sp.Expr, dims: dict[sp.Expr, Dim]) -> Dim | None:
