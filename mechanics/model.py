@@ -446,7 +446,7 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
 
     def number(e: Any) -> float | None:
         try:
-            return float(sp.sympify(e).xreplace(numbers))
+            return float(e.xreplace(numbers))
         except (TypeError, ValueError):
             return None
 

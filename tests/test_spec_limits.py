@@ -165,6 +165,7 @@ def test_json_true_is_not_a_number_in_a_request(client, field):
         (("bodies", 0, "mass"), True, "bodies[0].mass"),
         (("springs", 0, "k"), False, "springs[0].k"),
         (("units",), {"x": "banana"}, "units.x"),
+        (("units",), {"m": r"kg\input{/etc/passwd}"}, "units.m"),
         (("forces",), [{"on": "O", "vector": [1, 0, 0]}], "forces[0].on"),
         (
             ("frames",),
