@@ -659,7 +659,8 @@ def _why_it_stopped(c: CompiledScene, params: list[float], req: Any, run: Trajec
             "method (DOP853), which shrinks its steps where the motion is fast and tells the two "
             "apart."
         ]
-    growth = _growth(c, params, req, run)
+    # out of wall time, a growing state may be a resonance still climbing, not a blow-up
+    growth = None if "wall-time" in text else _growth(c, params, req, run)
     if growth is not None:
         before, after = growth
         return [
