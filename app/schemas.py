@@ -195,7 +195,8 @@ class SimulateRequest(DeriveRequest):
     fps: Finite = Field(
         default=60.0,
         description="Output samples per second (> 0), as many as t_end × fps + 1 ≤ 20001 "
-        "samples allow: 100 samples over 1 ms is fps = 1e5.",
+        "samples allow: 100 samples over 1 ms is fps = 1e5. A fixed-step run samples every "
+        "whole number of its steps nearest 1/fps instead (stats.sample_interval).",
     )
     method: MethodName = Field(  # type: ignore[valid-type]
         default="DOP853",
