@@ -27,7 +27,9 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+import re
 import time
+import unicodedata
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -204,7 +206,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         if verdict.pole and not _held_at_pole(d, variant, q0, values):
             warnings.append(
-                f"Every Q_j vanishes at {_point_text(m, q0)}, a pole of the coordinates, only "
+                f"Every $Q_j$ vanishes at {_point_text(m, q0)}, a pole of the coordinates, only "
                 "because they cannot move in every direction there: beside it the forces do not "
                 "shrink to 0 (a force or torque acts along a direction they lose there), so it is "
                 "not an equilibrium and is left out."
@@ -218,13 +220,14 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = _one_per_configuration(m, results, verdicts, values, warnings)
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
     families += [v.family for v in verdicts if v.family and v.family not in families]
-    steps.append(_stability_step(results, verdicts))
+    steps.append(_stability_step(m, results, verdicts))
     dry = _once(d, "dry friction", "", lambda: _dry_friction(d))
     if dry:
         warnings.append(
             "Dry friction acts here (a force with the sign of a velocity): at rest it can take "
-            "any value up to its limit, which the forces at q̇ = 0 above leave out. A body at "
-            "rest stays at rest wherever static friction can hold the other forces (|F| ≤ μN)"
+            "any value up to its limit, which the forces at $\\dot q = 0$ above leave out. A "
+            "body at rest stays at rest wherever static friction can hold the other forces "
+            r"($|F| \le \mu N$)"
             + (": the scene's stop conditions say where." if m.spec.stops else ".")
         )
     if results:  # a family is said only where one of its members is listed
@@ -363,12 +366,12 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
     names = ", ".join(m.coordinate_names[j] for j in idle)
     if everything:
         return (
-            "No force acts at rest at these parameters (every Q_j vanishes at q̇ = 0): every "
-            "configuration is an equilibrium (a family), none held by a restoring force: the "
+            r"No force acts at rest at these parameters (every $Q_j$ vanishes at $\dot q = 0$): "
+            "every configuration is an equilibrium (a family), none held by a restoring force: the "
             "list shows one of them, and what a nudge does there."
         )
     return (
-        f"At these parameters no force acts at rest along {names} (its Q vanishes for every "
+        f"At these parameters no force acts at rest along {names} (its $Q$ vanishes for every "
         f"value of it): every value of {names} is an equilibrium (a family); the list shows "
         f"{names} = 0 of each."
     )
@@ -416,7 +419,8 @@ def _inside_the_model(m, results, verdicts, values, warnings):
 
 
 _NOT_SMOOTH = (
-    "the forces are not differentiable at rest (a sign(q̇) of Coulomb friction, say), so there "
+    r"the forces are not differentiable at rest (a $\operatorname{sgn}(\dot q)$ of Coulomb "
+    "friction, say), so there "
     "is no linearization: the linear test cannot decide"
 )
 _NOT_SMOOTH_WARNING = (
@@ -1184,6 +1188,11 @@ def _starts(system: _System) -> np.ndarray:
 
 # --- the work of the non-conservative forces --------------------------------------------------
 
+#: The reasons carry their math as $…$ LaTeX, as the steps' prose does, so that the page typesets
+#: it and the LaTeX export keeps it math (plain 'e^(3.1 t)' read as a caret and a bracket).
+_POWER = r"\sum_j Q_j \dot q_j"
+_LINEARIZED = r"$M\,\delta\ddot q + C\,\delta\dot q + K\,\delta q = 0$"
+
 
 @dataclass(frozen=True)
 class Power:
@@ -1193,7 +1202,7 @@ class Power:
     their power P = Σ_j Q_j q̇_j is 0 (gyroscopic: a magnetic force) or ≤ 0 (dissipative: a
     damper), not when P has no sign (c ẋ³ pumps energy in at c ẋ⁴, while the linearization
     sees nothing and calls it a minimum). ``kind``: "none", "no work", "dissipative" or
-    "no sign"; ``text``: P as derived, for the sentence."""
+    "no sign"; ``text``: P = … as derived, in $…$, for the sentence."""
 
     kind: str = "none"
     text: str = ""
@@ -1241,15 +1250,15 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
         leaky = any(float(c.xreplace(values)) < 0 for c in dampers)
     except (TypeError, ValueError):
         leaky = True
-    text = to_plain(power)
     if leaky:
-        return Power("no sign", "−c ℓ̇² of a damper with c < 0")
+        return Power("no sign", rf"${_POWER} = -c\,\dot\ell^2$ of a damper with $c < 0$")
     if not moves:
         return Power("dissipative" if dampers else "none")
     at = sp.expand(power.xreplace(values)) if power != 0 else power
     if at == 0:  # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0
         return Power("dissipative" if dampers else "no work")
     proven = _once(d, "never positive", at, lambda: _never_positive(m, at))
+    text = f"${_POWER} = {_once(d, 'power latex', '', lambda: to_latex(power))}$"
     if proven or _quadratic_wins(m, at, q0):
         return Power("dissipative", text)
     return Power("no sign", text)
@@ -1305,8 +1314,8 @@ _NOT_ELEMENTARY = (sp.sign, sp.Abs, sp.DiracDelta, sp.Heaviside, sp.Derivative, 
 #: one instant say nothing of the motion (Floquet's theory would).
 _TIMED = "timed"
 _TIME_VARYING = (
-    "the linearization M δq̈ + C δq̇ + K δq = 0 depends on time here (a velocity-dependent force "
-    "that varies with t): eigenvalues at one instant do not decide, and the linear test cannot"
+    f"the linearization {_LINEARIZED} depends on time here (a velocity-dependent force "
+    "that varies with $t$): eigenvalues at one instant do not decide, and the linear test cannot"
 )
 
 
@@ -1494,20 +1503,20 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     mode that moves a radial coordinate comes twice. Otherwise the missing modes are unknown,
     and the verdict says so rather than show a short list."""
     verdict.pole = True
-    lost_names = ", ".join(m.coordinate_names[j] for j in lost)
-    where = ", ".join(f"{m.coordinate_names[j]} = {q0[j]:.4g}" for j in idx)
+    lost_names = ", ".join(f"${to_latex(m.q[j])}$" for j in lost)
+    where = "$" + ", ".join(f"{to_latex(m.q[j])} = {_num(q0[j])}" for j in idx) + "$"
     inertia = float(np.max(np.abs(full_M), initial=0.0))
     if all(np.max(np.abs(full_M[j])) <= 1e-12 * inertia for j in lost):
-        why = f"any {lost_names} names the same point: its row of M vanishes"
+        why = f"any {lost_names} names the same point: its row of $M$ vanishes"
     else:  # Euler angles at θ = 0: φ and ψ turn about one axis
         why = (
-            f"M is singular here for every parameter value, not for these numbers only: a turn "
+            f"$M$ is singular here for every parameter value, not for these numbers only: a turn "
             f"of {lost_names} is one the other coordinates make too, so any {lost_names} names "
             "the same configuration up to them"
         )
     pole = (
         f"{where} is a pole of the coordinates ({why}), so only "
-        f"{', '.join(m.coordinate_names[j] for j in idx)} was linearized"
+        f"{', '.join(f'${to_latex(m.q[j])}$' for j in idx)} was linearized"
     )
     radial = _radial(m, full_M, at_rest, q0, numbers, idx, lost)
     cyclic = all(j in free for j in lost)
@@ -1540,22 +1549,20 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
         (f, mode, phase) for f, mode, phase in modes if max(abs(mode[j]) for j in radial) > 1e-9
     ]
     modes.sort(key=lambda fmp: fmp[0])
-    before = _eigen_text(np.array(verdict.eigenvalues))
+    before = _eigen_math(np.array(verdict.eigenvalues))
     verdict.eigenvalues = _eigen_sorted(np.array([*verdict.eigenvalues, *twins]))
-    verdict.reason = verdict.reason.replace(
-        f"eigenvalues {before})", f"eigenvalues {_eigen_text(np.array(verdict.eigenvalues))})"
-    )
+    verdict.reason = verdict.reason.replace(before, _eigen_math(np.array(verdict.eigenvalues)))
     verdict.frequencies = [f for f, _, _ in modes]
     verdict.modes = [mode for _, mode, _ in modes]
     verdict.phases = [phase for _, _, phase in modes]
-    radial_names = ", ".join(m.coordinate_names[j] for j in radial)
+    radial_names = ", ".join(f"${to_latex(m.q[j])}$" for j in radial)
     verdict.reason += (
         f"; {pole}. By the symmetry in {lost_names} each motion of {radial_names} comes twice, "
         "in two perpendicular planes: "
         + (
             "it falls away in both, at the same rate"
             if verdict.kind == "unstable"
-            else "two degenerate modes of equal ω"
+            else r"two degenerate modes of equal $\omega$"
         )
         + ", which these coordinates cannot tell apart at the pole"
     )
@@ -1614,18 +1621,18 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     k_null = int(np.sum(np.abs(k_eigs) <= k_tol))
     k_pd_off_free = symmetric and int(np.sum(k_eigs > k_tol)) == n - n_free and k_null == n_free
     c_psd = np.all(np.linalg.eigvalsh(Cs) >= -1e-9 * max(1.0, float(np.max(np.abs(C)))))
-    shown = _eigen_text(lam)
+    shown = _eigen_math(lam)
     if np.max(lam.real) > tol:
         grow = lam[np.argmax(lam.real)]
         reason = (
-            f"an eigenvalue has positive real part (λ = {_z(grow)}): a small displacement "
-            f"grows like e^({grow.real:.4g} t)"
+            rf"an eigenvalue has positive real part ($\lambda = {_z(grow)}$): a small "
+            rf"displacement grows like $e^{{{_num(grow.real)}\,t}}$"
         )
         if not symmetric:
             reason += "; " + _circulatory(grow, tol)
         elif np.min(k_eigs) < -k_tol and not gyroscopic:
             reason += (
-                f"; K has a negative eigenvalue: the {_potential(turning)} has no minimum here"
+                f"; $K$ has a negative eigenvalue: the {_potential(turning)} has no minimum here"
             )
         return "unstable", reason, lam, vecs
     zero = np.abs(lam) <= 1e-6 * scale
@@ -1635,7 +1642,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             nudge = (
                 f"the {_gyroscopic(turning, power)} terms turn a nudge in velocity into a bounded "
                 "loop, "
-                "not a drift, but K is singular in every direction and nonlinear terms decide "
+                "not a drift, but $K$ is singular in every direction and nonlinear terms decide "
                 "(neutral at best)"
             )
         elif damped:
@@ -1650,7 +1657,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             )
         return (
             "marginal",
-            "every coordinate is free: no force acts at rest in any direction (K = 0), so every "
+            "every coordinate is free: no force acts at rest in any direction ($K = 0$), so every "
             f"nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
             lam,
             vecs,
@@ -1677,7 +1684,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     if k_null > n_free:
         return (
             "marginal",
-            "K is singular in a direction that is not a free coordinate (eigenvalues "
+            "$K$ is singular in a direction that is not a free coordinate (eigenvalues "
             f"{shown}): the quadratic approximation is flat there, so the linear test cannot "
             "decide; higher-order terms do (a bifurcation point, or a family of equilibria)",
             lam,
@@ -1701,9 +1708,9 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     if k_pd_off_free and c_psd and power.kind == "no sign":
         return (
             "marginal",
-            f"K is positive definite (the {_potential(turning)} has a minimum here) and no "
+            f"$K$ is positive definite (the {_potential(turning)} has a minimum here) and no "
             f"eigenvalue has positive real part ({shown}), but the velocity-dependent forces' "
-            f"power Σ Q_j q̇_j = {power.text} has no sign: they can feed energy in, which the "
+            f"power {power.text} has no sign: they can feed energy in, which the "
             "linearization does not see, so the minimum need not hold the motion "
             "(Lagrange–Dirichlet needs forces that do no positive work) and the linear test "
             f"cannot decide{free_note}",
@@ -1711,26 +1718,26 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             vecs,
         )
     if k_pd_off_free and c_psd:
-        reason = f"K is positive definite, so the {_potential(turning)} has a minimum here"
+        reason = f"$K$ is positive definite, so the {_potential(turning)} has a minimum here"
         if n_free:  # K is singular along the free directions: definite only off them
             reason = (
-                f"K is positive definite off the {n_free} free direction(s), so the "
+                f"$K$ is positive definite off the {n_free} free direction(s), so the "
                 f"{_potential(turning)} has a minimum across them"
             )
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
             reason = (
-                f"K is positive definite, so the {_potential(turning)} has a minimum; "
+                f"$K$ is positive definite, so the {_potential(turning)} has a minimum; "
                 "velocity-linear terms cannot undo that (Thomson–Tait)"
             )
         if power.kind == "no work":
             reason += (
-                "; the velocity-dependent forces do no work (their power Σ Q_j q̇_j is 0), so "
+                f"; the velocity-dependent forces do no work (their power ${_POWER} = 0$), so "
                 "the energy cannot grow"
             )
         elif power.kind == "dissipative" and power.text:
             reason += (
-                f"; the velocity-dependent forces' power Σ Q_j q̇_j = {power.text} is ≤ 0 "
-                "here: they only take energy out"
+                f"; the velocity-dependent forces' power {power.text} is $\\le 0$ here: they "
+                "only take energy out"
             )
         if damped:
             reason += ", and damping makes the motion decay"
@@ -1747,9 +1754,9 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     ):
         return (
             "gyroscopically stable",
-            f"K is not positive definite (its eigenvalues {', '.join(f'{k:.4g}' for k in k_shown)}"
-            f"), but the {_gyroscopic(turning, power)} terms C keep every eigenvalue on the "
-            "imaginary "
+            f"$K$ is not positive definite (its eigenvalues ${', '.join(_num(k) for k in k_shown)}"
+            f"$), but the {_gyroscopic(turning, power)} terms (in $C$) keep every eigenvalue on "
+            "the imaginary "
             f"axis without repeated defective ones ({shown}): the linearized motion stays "
             "bounded. Any damping would destroy this (Kelvin–Tait–Chetaev), and nonlinear terms "
             "may too",
@@ -1760,11 +1767,11 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
         why = "a repeated eigenvalue on the imaginary axis lacks a full set of eigenvectors"
     elif power.kind == "no sign":
         why = (
-            f"the velocity-dependent forces' power Σ Q_j q̇_j = {power.text} has no sign (they "
+            f"the velocity-dependent forces' power {power.text} has no sign (they "
             "can feed energy in)"
         )
     else:
-        why = "K is not positive definite and no gyroscopic term accounts for the stability"
+        why = "$K$ is not positive definite and no gyroscopic term accounts for the stability"
     return (
         "marginal",
         f"no eigenvalue has positive real part ({shown}), but {why}: the linear test cannot "
@@ -1775,8 +1782,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
 
 
 _CIRCULATORY = (
-    "K is not symmetric: position-dependent non-conservative (circulatory) forces act, a "
-    "follower load say, so no potential stands behind K and its eigenvalues say nothing of a "
+    "$K$ is not symmetric: position-dependent non-conservative (circulatory) forces act, a "
+    "follower load say, so no potential stands behind $K$ and its eigenvalues say nothing of a "
     "minimum; only the eigenvalues of the full linearization decide"
 )
 
@@ -1785,7 +1792,7 @@ def _circulatory(grow: complex, tol: float) -> str:
     """Why an equilibrium under circulatory forces is lost: flutter or divergence."""
     if abs(grow.imag) > tol:
         return (
-            f"{_CIRCULATORY}: flutter, a complex pair {_z(grow)} and its conjugate with positive "
+            f"{_CIRCULATORY}: flutter, a complex pair ${_z(grow)}$ and its conjugate with positive "
             "real part, an oscillation that grows"
         )
     return f"{_CIRCULATORY}: divergence, a real positive eigenvalue, a drift that grows"
@@ -1828,7 +1835,7 @@ def _eigen_sorted(lam: np.ndarray) -> list[complex]:
 
 def _potential(turning: bool) -> str:
     if turning:
-        return "effective potential (V with the centrifugal term of the turning frame)"
+        return "effective potential ($V$ with the centrifugal term of the turning frame)"
     return "potential"
 
 
@@ -1890,15 +1897,30 @@ def _modes(M, C, K, lam, vecs, idx, n):
     return freqs, modes, phases
 
 
+def _num(x: float) -> str:
+    """x to 4 digits as LaTeX: 1.2 \\cdot 10^{-5}, not the 1.2e-05 that reads as e times 5."""
+    text = f"{x:.4g}"
+    if "e" not in text:
+        return text
+    mantissa, exponent = text.split("e")
+    return rf"{mantissa} \cdot 10^{{{int(exponent)}}}"
+
+
 def _z(z: complex) -> str:
+    """One eigenvalue, as LaTeX (inside $…$)."""
     if abs(z.imag) <= 1e-12:
-        return f"{z.real:.4g}"
-    sign = "−" if z.imag < 0 else "+"
-    return f"{z.real:.4g} {sign} {abs(z.imag):.4g}i"
+        return _num(z.real)
+    sign = "-" if z.imag < 0 else "+"
+    return f"{_num(z.real)} {sign} {_num(abs(z.imag))}i"
+
+
+def _eigen_math(lam: np.ndarray) -> str:
+    """$λ = …$, each conjugate pair once as a ± b i, and the imaginary-axis ones as ±b i."""
+    return rf"$\lambda = {_eigen_text(lam)}$"
 
 
 def _eigen_text(lam: np.ndarray) -> str:
-    """λ, each conjugate pair once as a ± b i, and the imaginary-axis ones as ±b i."""
+    """The λ of ``_eigen_math`` as LaTeX, without the $."""
     parts = []
     scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
     for z in lam:
@@ -1907,11 +1929,11 @@ def _eigen_text(lam: np.ndarray) -> str:
         if abs(z) <= 1e-9 * scale:
             parts.append("0")  # round-off of a zero eigenvalue: −9.7e-17 said nothing
         elif abs(z.imag) <= 1e-12:
-            parts.append(f"{z.real:.4g}")
+            parts.append(_num(z.real))
         elif abs(z.real) <= 1e-9 * max(1.0, abs(z)):
-            parts.append(f"±{z.imag:.4g}i")
+            parts.append(rf"\pm {_num(z.imag)}i")
         else:
-            parts.append(f"{z.real:.4g} ± {z.imag:.4g}i")
+            parts.append(rf"{_num(z.real)} \pm {_num(z.imag)}i")
     return ", ".join(parts)
 
 
@@ -1933,28 +1955,92 @@ def _linear_latex(linear: dict) -> str:
 
 
 def _latex_text(s: str) -> str:
-    return "".join("\\" + c if c in "#$%&_{}" else c for c in s).replace("^", r"\^{}")
+    return "".join("\\" + c if c in "#$%&_{}^~\\" else c for c in s)
 
 
-def _stability_step(results: list[dict], verdicts: list[Verdict]) -> Step:
-    text = (
-        "About each equilibrium q₀ the motion linearizes to M δq̈ + C δq̇ + K δq = 0 with "
-        "K = −∂f/∂q and C = −∂f/∂q̇ at rest (C holds damping and the gyroscopic terms: "
-        "Coriolis where a frame turns, forces that do no work such as a magnetic one). With "
-        "δq ∝ e^{λt} the eigenvalues λ of the first-order system decide: any Re λ > 0 is "
-        "unstable; all Re λ < 0 is asymptotically stable; K symmetric and positive definite is "
-        "stable by the potential (Lagrange–Dirichlet) when the velocity-dependent forces do no "
-        "positive work (their power Σ Q_j q̇_j is 0 or ≤ 0), and undecided when it has no "
-        "sign; a K that is not symmetric (circulatory forces) has no potential behind it, so "
-        "only the eigenvalues speak; K not positive definite with every λ simple on the "
-        "imaginary axis is gyroscopically stable (only linearly: damping destroys it); what "
-        "the linear test cannot decide is marginal. "
-        "The small-oscillation frequencies are the imaginary parts ω = Im λ."
+def reason_latex(reason: str) -> str:
+    r"""A reason as one LaTeX expression: its words in \text{…}, its $…$ math as math (inside
+    \text a caret printed as 'e\^{}(3.1 t)' and a name as 'theta')."""
+    parts = reason.split("$")
+    if len(parts) % 2 == 0:  # an unpaired $: all of it is words
+        return rf"\text{{{_latex_text(reason)}}}"
+    return "".join(
+        part if k % 2 else rf"\text{{{_latex_text(part)}}}" for k, part in enumerate(parts) if part
     )
+
+
+#: The macros the reasons use, as plain text (the rest: Greek letters, by their Unicode names).
+_PLAIN_MACROS = {
+    ",": " ",
+    " ": " ",
+    "pm": "±",
+    "le": "≤",
+    "cdot": "·",
+    "sum": "Σ",
+    "partial": "∂",
+    "ell": "ℓ",
+    "quad": " ",
+    "left": "",
+    "right": "",
+    "operatorname": "",
+    "mathrm": "",
+}
+#: Unicode's names where TeX's differ (λ is LAMDA there).
+_GREEK_SPELLING = {"lambda": "lamda", "varphi": "phi", "vartheta": "theta symbol"}
+
+
+def _plain_macro(name: str) -> str:
+    if name in _PLAIN_MACROS:
+        return _PLAIN_MACROS[name]
+    spelled = _GREEK_SPELLING.get(name, name)
+    try:
+        return unicodedata.lookup(f"GREEK SMALL LETTER {spelled.upper()}")
+    except KeyError:
+        return name
+
+
+def reason_plain(reason: str) -> str:
+    r"""A reason as plain text (the step's copy button): $…$ dropped, \dot x as ẋ, and the
+    macros the reasons use as their symbols."""
+    text = re.sub(  # every macro but the accents, which then sit on a letter
+        r"\\(?!d?dot(?![A-Za-z]))([A-Za-z]+|.)",
+        lambda m: _plain_macro(m.group(1)),
+        reason.replace("$", ""),
+    )
+    text = re.sub(
+        r"\\(d?dot)\s*\{?([^\s{}\\])\}?",
+        lambda m: m.group(2) + ("\u0308" if m.group(1) == "ddot" else "\u0307"),
+        text,
+    )
+    return unicodedata.normalize("NFC", text.replace("{", "").replace("}", ""))
+
+
+def _stability_step(m: Any, results: list[dict], verdicts: list[Verdict]) -> Step:
+    text = (
+        rf"About each equilibrium $q_0$ the motion linearizes to {_LINEARIZED} with "
+        r"$K = -\partial f/\partial q$ and $C = -\partial f/\partial \dot q$ at rest ($C$ "
+        "holds damping and the gyroscopic terms: Coriolis where a frame turns, forces that do "
+        r"no work such as a magnetic one). With $\delta q \propto e^{\lambda t}$ the eigenvalues "
+        r"$\lambda$ of the first-order system decide: any $\operatorname{Re}\lambda > 0$ is "
+        r"unstable; all $\operatorname{Re}\lambda < 0$ is asymptotically stable; $K$ symmetric "
+        "and positive definite is stable by the potential (Lagrange–Dirichlet) when the "
+        f"velocity-dependent forces do no positive work (their power ${_POWER}$ is 0 or "
+        r"$\le 0$), and undecided when it has no sign; a $K$ that is not symmetric "
+        "(circulatory forces) has no potential behind it, so only the eigenvalues speak; $K$ "
+        "not positive definite with every $\\lambda$ simple on the imaginary axis is "
+        "gyroscopically stable (only linearly: damping destroys it); what the linear test "
+        "cannot decide is marginal. The small-oscillation frequencies are the imaginary parts "
+        r"$\omega = \operatorname{Im}\lambda$."
+    )
+    tex = {name: to_latex(q) for name, q in zip(m.coordinate_names, m.q, strict=True)}
     lines = []
     for r, v in zip(results, verdicts, strict=True):
         # a free coordinate is 'any φ', as the panel says it: 'φ = 0' named one of the family
         q = ", ".join(f"any {k}" if k in r["free"] else f"{k} = {x:.4g}" for k, x in r["q"].items())
+        q_tex = r",\ ".join(
+            rf"\text{{any }}{tex[k]}" if k in r["free"] else f"{tex[k]} = {_num(x)}"
+            for k, x in r["q"].items()
+        )
         if v.linear is not None:
             linear = v.linear
             lines.append(
@@ -1966,13 +2052,13 @@ def _stability_step(results: list[dict], verdicts: list[Verdict]) -> Step:
                 )
             )
         freqs = ", ".join(f"{f:.4g}" for f in v.frequencies)
-        omega = rf"\quad \omega = {freqs}\ \mathrm{{rad/s}}" if freqs else ""
+        omega = rf"\quad \omega = {', '.join(_num(f) for f in v.frequencies)}\ \mathrm{{rad/s}}"
         lines.append(
             Line(
                 q,
-                rf"\text{{{_latex_text(q)}: {v.kind}}}{omega}"
-                rf"\\ \text{{because {_latex_text(v.reason)}}}",
-                f"{q}: {v.kind} {freqs}".rstrip() + f" — because {v.reason}",
+                rf"{q_tex}:\ \text{{{v.kind}}}{omega if freqs else ''}"
+                rf"\\ \text{{because }}{reason_latex(v.reason)}",
+                f"{q}: {v.kind} {freqs}".rstrip() + f" — because {reason_plain(v.reason)}",
             )
         )
     return Step("stability", "Stability and small oscillations", text, lines)

@@ -20,18 +20,27 @@ const KIND_CLASS = {
  * slate #3b4a63 on #e8edf5 is 7.6:1 (AA needs 4.5:1 for its small type). */
 const NEUTRAL = { color: "#3b4a63", background: "#e8edf5" };
 
-/** The first time the panel says K (or C), what it is: the reasons speak of them as known. */
+/** The first time the panel says $K$ (or $C$), what it is: the reasons speak of them as known.
+ * The gloss follows the reason: K is the Hessian of V only where a potential stands behind it
+ * (not under a follower load, and of the effective potential where a frame turns); C's
+ * symmetric part is damping and its antisymmetric part gyroscopic, whatever their source (the
+ * reason names it: Coriolis only where a frame turns, else forces that do no work). */
 const GLOSSES = [
-  [/\bK\b/, "the stiffness matrix K = ∂²V/∂q²"],
-  [/\bC\b/, "the velocity matrix C = −∂Q/∂q̇ (damping, Coriolis)"],
+  ["$K$", (text) => (/not symmetric/.test(text)
+    ? "the stiffness matrix $K$ (the restoring force per unit displacement, not the Hessian of any potential)"
+    : /effective potential/.test(text)
+      ? "the stiffness matrix $K$ (the Hessian of the effective potential)"
+      : "the stiffness matrix $K = \\partial^2 V/\\partial q^2$")],
+  ["$C$", () => "$C$ (the velocity matrix: its symmetric part damping, its antisymmetric part gyroscopic)"],
 ];
 
-/** `text` with the first unglossed K or C explained in place; `said` keeps what was. */
+/** `text` with the first unglossed $K$ or $C$ explained in place; `said` keeps what was. */
 function glossed(text, said) {
-  for (const [pattern, gloss] of GLOSSES) {
-    if (said.has(pattern) || !pattern.test(text)) continue;
-    said.add(pattern);
-    text = text.replace(pattern, gloss);
+  for (const [symbol, gloss] of GLOSSES) {
+    if (said.has(symbol) || !text.includes(symbol)) continue;
+    said.add(symbol);
+    const words = gloss(text);
+    text = text.replace(symbol, () => words);
   }
   return text;
 }
@@ -45,7 +54,7 @@ function sameShape(a, b) {
 const KIND_WORDS = {
   "stable": "Stable: the potential has a minimum here",
   "asymptotically stable": "Asymptotically stable: damping makes every small motion die out",
-  "gyroscopically stable": "Gyroscopically stable: not a minimum of the potential, but the Coriolis terms keep small motions bounded (any damping would undo it)",
+  "gyroscopically stable": "Gyroscopically stable: not a minimum of the potential, but gyroscopic terms (forces that do no work, or Coriolis where a frame turns) keep small motions bounded (any damping would undo it)",
   "marginal": "Marginal: neutral (no force pulls it back along some direction) or undecided by the linear test",
   "unstable": "Unstable: a small displacement grows",
 };
@@ -108,7 +117,8 @@ export async function showEquilibria(box, target, parameters, startAt, spec = nu
       tag.title = KIND_WORDS[kind] || "";
       // the reason says why in full; the kind's own gloss would say half of it twice
       if (e.reason) {
-        li.querySelector(".why").textContent = glossed(`${kind[0].toUpperCase()}${kind.slice(1)}: ${e.reason}.`, said);
+        // its math ($…$) typeset with the rest of the list, as the derivation's steps are
+        li.querySelector(".why").textContent = inlineMath(glossed(`${kind[0].toUpperCase()}${kind.slice(1)}: ${e.reason}.`, said));
       }
       if (spec) {
         const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
