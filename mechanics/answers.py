@@ -140,6 +140,8 @@ def to_convention_mapped(
             continue
         if kind == "op" and value == "**" and out and out[-1][0] == "name":
             if out[-1][1] in FUNCTIONS:  # sin^2(θ), sin^2 θ: the notes' sin²θ is sin(θ)^2
+                if power is not None:  # sin^2^2: no argument yet, a second power
+                    raise ExprError(_FUNCTION_POWER, field=field, position=at)
                 power = ""
                 continue
         if power is not None:
@@ -380,11 +382,25 @@ def _time_derivatives(
                 typed,
                 where[start],
             )
+        if inner.has(sp.Abs, sp.sign):
+            raise _pointed(
+                "d/dt of abs() or sign() has no derivative where its argument is 0: write the "
+                "derivative out for the side the motion stays on",
+                typed,
+                where[start],
+            )
         derivative = sp.diff(inner, T) if sp.count_ops(inner) <= MAX_DDT_OPS else None
         if derivative is None or sp.count_ops(derivative) > 2 * MAX_DDT_OPS:
             raise _pointed(
                 "the expression under d/dt is too long to differentiate here: write its "
                 "derivative out",
+                typed,
+                where[start],
+            )
+        rates = {*(q.diff(T) for q in model.q), *model.qdd}
+        if not derivative.atoms(sp.Derivative) <= rates:  # sympy left one unevaluated
+            raise _pointed(
+                "this d/dt is not one the checker can take: write its derivative out",
                 typed,
                 where[start],
             )

@@ -937,10 +937,10 @@ class _Judge:
         self._diagnose(given, expected, fb)
 
     def _inertia_only(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> bool:
-        """An equation whose force terms are the derived ones (times a number) and whose q̈_j
-        coefficient is not: the error is the inertia ((m₁ − m₂) ẍ for (m₁ + m₂) ẍ). Reading it
-        as the derived equation scaled to match the q̈ term would blame the forces instead,
-        and by a factor that can vanish (m₁ = m₂)."""
+        """An equation whose other terms (the forces) are the derived ones (times a number)
+        and whose q̈_j coefficient is not: the error is the inertia ((m₁ − m₂) ẍ for
+        (m₁ + m₂) ẍ). Reading it as the derived equation scaled to match the q̈ term would
+        blame the forces instead, and by a factor that can vanish (m₁ = m₂)."""
         qdd = self.m.qdd[self.j]
         mine, theirs = partial(given, qdd, self.m), partial(expected, qdd, self.m)
         if theirs == 0 or mine.has(qdd) or theirs.has(qdd):
@@ -957,7 +957,7 @@ class _Judge:
         how = f"you have {inline(wrong)} where {inline(right)} belongs"
         scaled = "" if forces == 1 else f" (as the derived equation times {inline(forces)})"
         fb.append(
-            f"The forces in your equation are right{scaled}, but the inertia term "
+            f"Every other term of your equation is right{scaled}, but the inertia term "
             f"(the {inline(qdd)} term) is not: {how}. Its coefficient is the inertia every "
             "force on the system has to accelerate."
         )
