@@ -104,18 +104,26 @@ def test_a_q_wrong_otherwise_is_not_said_to_hold_the_conservative_part():
 # --- 2. a constant added to V must be an energy -----------------------------------------------
 
 
-@pytest.mark.parametrize("quantity", ["T", "V"])
+RIGHT = {  # by hand: the bob at l (sin θ, −cos θ), speed l θ̇, height −l cos θ
+    "T": "m*l**2*theta_dot**2/2",
+    "V": "-m*g*l*cos(theta)",
+    "L": "m*l**2*theta_dot**2/2 + m*g*l*cos(theta)",
+}
+
+
+@pytest.mark.parametrize("quantity", ["T", "V", "L"])
 @pytest.mark.parametrize("added", ["m", "l", "g", "5"])
-def test_a_constant_that_is_no_energy_is_a_unit_error_in_t_and_v(quantity, added):
-    right = {"T": "m*l**2*theta_dot**2/2", "V": "-m*g*l*cos(theta)"}[quantity]
+def test_a_constant_that_is_no_energy_is_a_unit_error_in_t_v_and_l(quantity, added):
+    right = RIGHT[quantity]
     v = verdict("simple_pendulum", quantity, f"{right} + {added}")
     assert v.correct is False, v.feedback
     assert any("units" in line and "not an energy" in line for line in v.feedback), v.feedback
 
 
+@pytest.mark.parametrize("quantity", ["V", "L"])
 @pytest.mark.parametrize("added", ["m*g*l", "5*m*g*l", "m*l**2*g/(2*l)"])
-def test_a_constant_that_is_an_energy_only_moves_the_datum(added):
-    v = verdict("simple_pendulum", "V", f"-m*g*l*cos(theta) + {added}")
+def test_a_constant_that_is_an_energy_only_moves_the_datum(quantity, added):
+    v = verdict("simple_pendulum", quantity, f"{RIGHT[quantity]} + {added}")
     assert v.correct is True, v.feedback
 
 
