@@ -449,7 +449,7 @@ def test_an_answer_right_on_only_part_of_the_range_is_not_called_correct(quantit
     [
         ("T", "1/2 m l^2 sqrt(theta_dot^4)"),  # θ̇⁴ ≥ 0: right everywhere
         ("V", "-m g l cos(abs(theta))"),  # cos is even
-        ("V", "-m g l cos(theta) + 5"),  # a datum
+        ("V", "-m g l cos(theta) + 5*m*g*l"),  # a datum (an energy: a bare 5 is not one)
     ],
 )
 def test_answers_right_everywhere_stay_correct(quantity, answer):
