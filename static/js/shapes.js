@@ -107,7 +107,7 @@ export function sceneShapes(geom, view, i, opts = {}) {
       occupied.push(box);
     }
   }
-  if (o.scaleBar && !geom.is3D) scaleBar(view, out, o.font - 1);
+  if (o.scaleBar && !geom.is3D) scaleBar(view, out, o.font - 1, occupied);
   return out;
 }
 
@@ -419,12 +419,21 @@ export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 1
   out.push({ t: "text", at: [pick[0], pick[3] - below], text, color, size, halo: true });
 }
 
-function scaleBar(view, out, size) {
+/** A bar of a round length in a corner: the bottom-left one, or the first corner where neither
+ * the bar nor its label covers a body or a name (at lecture size the label is 25 px). */
+function scaleBar(view, out, size, occupied = []) {
   const target = 110 / view.scale;
   const p = 10 ** Math.floor(Math.log10(target));
   const nice = [1, 2, 5, 10].map((k) => k * p).filter((v) => v <= target).pop() || p;
-  const px = nice * view.scale, x = 14, y = view.h - 14;
-  out.push({ t: "poly", pts: [[x, y - 5], [x, y], [x + px, y], [x + px, y - 5]], color: "#868e96", width: 1.5 });
+  const px = nice * view.scale;
   const label = nice >= 1 ? `${nice} m` : nice >= 0.01 ? `${Math.round(nice * 100)} cm` : `${nice} m`;
+  const width = px + 6 + 0.6 * size * label.length;
+  // (not the top-left corner: the canvas's notes are written there)
+  const corners = [[14, view.h - 14], [view.w - 14 - width, view.h - 14], [view.w - 14 - width, 14 + size]];
+  const boxOf = ([x, y]) => [x, y - Math.max(size, 5), x + width, y + 4];
+  const free = (b) => !occupied.some((o) => b[0] < o[2] && b[2] > o[0] && b[1] < o[3] && b[3] > o[1]);
+  const [x, y] = corners.find((c) => free(boxOf(c))) || corners[0];
+  occupied.push(boxOf([x, y]));
+  out.push({ t: "poly", pts: [[x, y - 5], [x, y], [x + px, y], [x + px, y - 5]], color: "#868e96", width: 1.5 });
   out.push({ t: "text", at: [x + px + 6, y + 1], text: label, color: "#6c757d", size });
 }
