@@ -15,6 +15,7 @@ import math
 import re
 
 import pytest
+import sympy as sp
 
 from mechanics.derive import derivation_of_scene, derive_model
 from mechanics.equilibria import equilibria, reason_plain
@@ -127,3 +128,67 @@ def test_a_power_is_written_as_latex_not_python():
     (e,) = POSTED["cubic pumping"]["equilibria"]
     assert r"$\sum_j Q_j \dot q_j = c \dot{x}^{4}$" in e["reason"]
     assert "Σ_j Q_j q̇_j = c ẋ^4" in reason_plain(e["reason"])
+
+
+# --- one meaning per symbol: a parameter named E or Q ------------------------------------------
+
+
+def named_e_and_q(damped: bool) -> dict:
+    """A spring of stiffness E; with ``damped`` a dashpot force −Q ẋ (a textbook's E and Q)."""
+    spec = {
+        "title": "E and Q as parameters",
+        "coordinates": ["x"],
+        "parameters": {"m": 1.0, "E": 4.0, "Q": 0.5},
+        "bodies": [{"name": "b", "mass": "m", "position": ["x", 0, 0]}],
+        "springs": [{"name": "s", "a": "O", "b": "b", "k": "E"}],
+    }
+    if damped:
+        spec["forces"] = [{"name": "f", "on": "b", "vector": ["-Q*x_dot", 0, 0]}]
+    return spec
+
+
+def step(spec: dict, step_id: str) -> dict:
+    return next(s for s in derive_model(spec).steps if s.id == step_id).to_json()
+
+
+@pytest.mark.parametrize("damped", [False, True])
+def test_a_parameter_named_e_or_q_leaves_those_letters_to_it(damped):
+    """The energy (½ m ẋ² + ½ E x², by hand) is written 𝓔, the generalized forces 𝒬_j; the
+    letters E and Q, alone in the LaTeX, are the parameters. Without the parameters the
+    steps keep E and Q."""
+    spec = named_e_and_q(damped)
+    conserved, forces = step(spec, "conserved"), step(spec, "forces")
+    for s in (conserved, forces):
+        _, maths = words_and_math(s["text"])
+        assert not any(re.search(r"(?<![\\{A-Za-z])[EQ](?![A-Za-z])", m) for m in maths), maths
+    assert r"\mathcal{Q}_j" in forces["text"] and "named Q" in forces["text"]
+    assert forces["latex"] == [r"\mathcal{Q}_{x}^{NC} = " + ("- Q \\dot{x}" if damped else "0")]
+    if damped:  # energy changes: dE/dt = Σ Q_j q̇_j
+        assert r"d\mathcal{E}/dt = \sum_j \mathcal{Q}_j \dot q_j" in conserved["text"]
+    else:  # the energy line: 𝓔 = T + V = ½ m ẋ² + ½ E x², E the parameter
+        (line,) = conserved["latex"]
+        assert line.startswith(r"\mathcal{E} = T + V = ") and "named E" in conserved["text"]
+        x, x_dot, E, m = sp.symbols("x x_dot E m")
+        stated = sp.sympify(conserved["plain"][0].split("=", 1)[1], {"E": E})
+        assert sp.simplify(stated - (m * x_dot**2 / 2 + E * x**2 / 2)) == 0
+
+    plain = {**named_e_and_q(damped), "parameters": {"m": 1.0, "k": 4.0, "c": 0.5}}
+    plain["springs"] = [{"name": "s", "a": "O", "b": "b", "k": "k"}]
+    if damped:
+        plain["forces"] = [{"name": "f", "on": "b", "vector": ["-c*x_dot", 0, 0]}]
+    for s in (step(plain, "conserved"), step(plain, "forces")):
+        assert "mathcal" not in s["text"] + "".join(s["latex"]) and "named" not in s["text"]
+
+
+def test_the_forces_step_says_the_conservative_forces_are_in_v():
+    """Eq. 31 sums every force; the step computes only Q_j^NC, and says how the two relate:
+    Q_j = Q_j^NC − ∂V/∂q_j. A pendulum's weight is in V, so its Q_θ^NC = 0 (by hand)."""
+    s = step(load_scene("simple_pendulum"), "forces")
+    assert r"$Q_j = -\partial V/\partial q_j$" in s["text"] and "through $V$" in s["text"]
+    assert s["latex"] == [r"Q_{\theta}^{NC} = 0"]
+    s = step(load_scene("spring_mass_damper"), "forces")
+    assert "already in $V$" in s["text"]
+    assert r"$Q_j = Q_j^{NC} - \partial V/\partial q_j$" in s["text"]
+    damped = step(named_e_and_q(True), "forces")
+    assert r"\mathcal{Q}_j = \mathcal{Q}_j^{NC} - \partial V/\partial q_j" in damped["text"]
+    assert r"\vec F_i^{NC}" in damped["text"]

@@ -8,6 +8,7 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.model import T as t
 from mechanics.steps import Line, Step, Work, tidy
+from mechanics.steps.forces import derived_letter, letters_note
 
 
 def explicit_time(expr: sp.Expr, model: Model) -> bool:
@@ -32,6 +33,10 @@ def nc_power(model: Model, work: Work) -> sp.Expr:
 
 
 def conserved_quantities(model: Model, work: Work) -> Step:
+    """E = T + V, or the Jacobi integral h, when no force does work (eq. 23); p_j of a cyclic
+    coordinate. E, T, V, L and Q are written script where the scene has a parameter of that
+    name, as in the energy step, so that "E = T + V" never adds a parameter to energies."""
+    E_, T_, V_, L_, Q_ = (derived_letter(model, n) for n in ("E", "T", "V", "L", "Q"))
     lines: list[Line] = []
     found: list[dict] = []
     no_nc = all(Q == 0 for Q in work.Q)
@@ -41,14 +46,14 @@ def conserved_quantities(model: Model, work: Work) -> Step:
         E = tidy(work.T + work.V, model)
         if sp.expand(h - E) == 0 or tidy(h - E, model) == 0:
             found.append({"name": "energy", "coordinate": None, "expr": E})
-            lines.append(Line("E", f"E = T + V = {to_latex(E)}", f"E = {to_plain(E)}"))
+            lines.append(Line("E", f"{E_} = {T_} + {V_} = {to_latex(E)}", f"E = {to_plain(E)}"))
         else:
             found.append({"name": "jacobi", "coordinate": None, "expr": h})
             lines.append(
                 Line(
                     "h",
-                    rf"h = \sum_j \dot{{q}}_j \frac{{\partial L}}{{\partial "
-                    rf"\dot{{q}}_j}} - L = {to_latex(h)}",
+                    rf"h = \sum_j \dot{{q}}_j \frac{{\partial {L_}}}{{\partial "
+                    rf"\dot{{q}}_j}} - {L_} = {to_latex(h)}",
                     f"h = {to_plain(h)}",
                 )
             )
@@ -66,41 +71,45 @@ def conserved_quantities(model: Model, work: Work) -> Step:
             )
     work.conserved = found
     parts = []
+    power = rf"$\sum_j {Q_}_j \dot q_j$"
+    no_t = f"${L_}$ has no explicit $t$"
     if any(c["name"] == "energy" for c in found) and not no_nc:
         parts.append(
-            "$L$ has no explicit $t$, and the non-conservative forces' power "
-            r"$\sum_j Q_j \dot q_j$ simplifies to 0: they do no work (gyroscopic, like a "
-            r"magnetic force), so $E = T + V$ is conserved ($dE/dt = \sum_j Q_j \dot q_j = 0$, "
-            "eq. 23)."
+            f"{no_t}, and the non-conservative forces' power {power} simplifies to 0: they do "
+            f"no work (gyroscopic, like a magnetic force), so ${E_} = {T_} + {V_}$ is conserved "
+            rf"($d{E_}/dt = \sum_j {Q_}_j \dot q_j = 0$, eq. 23)."
         )
     elif any(c["name"] == "energy" for c in found):
         parts.append(
-            "$L$ has no explicit $t$ and no non-conservative force acts, so $E = T + V$ is "
-            r"conserved ($\Delta T + \Delta V = 0$, notes III)."
+            f"{no_t} and no non-conservative force acts, so ${E_} = {T_} + {V_}$ is "
+            rf"conserved ($\Delta {T_} + \Delta {V_} = 0$, notes III)."
         )
     elif any(c["name"] == "jacobi" for c in found):
         parts.append(
-            "The constraints move, so $T + V$ is not conserved, but $L$ has no explicit $t$: "
-            r"the Jacobi integral $h = \sum_j \dot q_j\, \partial L/\partial \dot q_j - L$ is"
+            f"The constraints move, so ${T_} + {V_}$ is not conserved, but {no_t}: the Jacobi "
+            rf"integral $h = \sum_j \dot q_j\, \partial {L_}/\partial \dot q_j - {L_}$ is"
             + (
                 "."
                 if no_nc
-                else r" (the non-conservative forces' power $\sum_j Q_j \dot q_j$ simplifies "
-                "to 0: they do no work)."
+                else f" (the non-conservative forces' power {power} simplifies to 0: they do "
+                "no work)."
             )
         )
     elif not no_work:
         parts.append(
-            r"Non-conservative forces do work: $dE/dt = \sum_j Q_j \dot q_j$, so $E$ changes by "
-            r"$W^{NC}$ (eq. 23)."
+            rf"Non-conservative forces do work: $d{E_}/dt = \sum_j {Q_}_j \dot q_j$, so ${E_}$ "
+            r"changes by $W^{NC}$ (eq. 23)."
         )
     else:
         parts.append(
-            "$L$ depends explicitly on $t$: neither $E$ nor the Jacobi integral is conserved."
+            f"${L_}$ depends explicitly on $t$: neither ${E_}$ nor the Jacobi integral is "
+            "conserved."
         )
     if any(c["name"] == "momentum" for c in found):
         parts.append(
-            r"A coordinate absent from $L$ (cyclic) has a conserved momentum "
-            r"$p_j = \partial L/\partial \dot q_j$."
+            f"A coordinate absent from ${L_}$ (cyclic) has a conserved momentum "
+            rf"$p_j = \partial {L_}/\partial \dot q_j$."
         )
-    return Step("conserved", "Conserved quantities", " ".join(parts), lines)
+    text = " ".join(parts)
+    used = [n for n in ("E", "T", "V", "L", "Q") if derived_letter(model, n) in text]
+    return Step("conserved", "Conserved quantities", text + letters_note(model, *used), lines)

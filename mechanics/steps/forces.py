@@ -7,6 +7,41 @@ import sympy as sp
 from mechanics.expr import to_latex
 from mechanics.model import Model
 from mechanics.steps import Step, Work, eq_line, tidy
+from mechanics.steps.energy import ENERGY_LETTERS, letter
+
+#: E (the energy) and Q (the generalized forces) take a script form by energy.letter's rule.
+OTHER_LETTERS = {"E": r"\mathcal{E}", "Q": r"\mathcal{Q}"}
+MEANINGS = {
+    "T": "kinetic energy",
+    "V": "potential energy",
+    "L": "Lagrangian",
+    "E": "energy",
+    "Q": "generalized forces",
+}
+
+
+def derived_letter(model: Model, name: str) -> str:
+    """T, V, L, E or Q as the derivation prints it: script when the scene has a parameter or
+    coordinate of that name, so that a posted spec's force Q never reads as the Q_j beside it."""
+    if name in ENERGY_LETTERS:
+        return letter(model, name)
+    taken = set(model.spec.parameters) | set(model.spec.coordinates)
+    return OTHER_LETTERS[name] if name in taken else name
+
+
+def letters_note(model: Model, *names: str) -> str:
+    """The sentence that says which of these letters are script here ('' when none is)."""
+    taken = [n for n in names if derived_letter(model, n) != n]
+    if not taken:
+        return ""
+    written = " and ".join(
+        f"the {MEANINGS[n]} as ${derived_letter(model, n)}{'_j' if n == 'Q' else ''}$"
+        for n in taken
+    )
+    return (
+        f" The scene has a parameter or coordinate named {' and '.join(taken)}, so this "
+        f"derivation writes {written}."
+    )
 
 
 def generalized_forces(model: Model, work: Work) -> Step:
@@ -23,16 +58,29 @@ def generalized_forces(model: Model, work: Work) -> Step:
             total += load.vector.dot(partial)
         Q.append(tidy(total, model))
     work.Q = Q
+    Q_, V_ = derived_letter(model, "Q"), derived_letter(model, "V")
+    L_, T_ = derived_letter(model, "L"), derived_letter(model, "T")
     lines = [
-        eq_line(f"Q_{name}", rf"Q_{{{to_latex(qi)}}}^{{NC}}", Qj, f"Q_{name}")
+        eq_line(f"Q_{name}", rf"{Q_}_{{{to_latex(qi)}}}^{{NC}}", Qj, f"Q_{name}")
         for name, qi, Qj in zip(model.coordinate_names, model.q, Q, strict=True)
     ]
+    # Eq. 31 sums every force, weights and springs too; those are in V already, and counted
+    # again here they would act twice in the Lagrange equations.
     if model.loads:
         text = (
-            "Project every non-conservative force on the virtual displacement it works "
-            r"through: $Q_j = \sum_i \vec F_i \cdot \partial \vec r_i/\partial q_j$ (eq. 31), and "
-            r"torques through $\partial \vec\omega/\partial \dot q_j$."
+            f"The conservative forces (weights, springs, potentials) are already in ${V_}$, so "
+            "only the non-conservative ones are projected here, each on the virtual "
+            "displacement it works through: "
+            rf"${Q_}_j^{{NC}} = \sum_i \vec F_i^{{NC}} \cdot \partial \vec r_i/\partial q_j$, "
+            r"and torques through $\partial \vec\omega/\partial \dot q_j$ (eq. 31 over these "
+            "forces alone). Eq. 31 over all the forces would give "
+            rf"${Q_}_j = {Q_}_j^{{NC}} - \partial {V_}/\partial q_j$; the conservative part "
+            rf"$-\partial {V_}/\partial q_j$ enters through ${L_} = {T_} - {V_}$ instead."
         )
     else:
-        text = "No non-conservative force acts: every $Q_j^{NC} = 0$ and all forces come from $V$."
-    return Step("forces", "Generalized forces", text, lines)
+        text = (
+            f"No non-conservative force acts: every ${Q_}_j^{{NC}} = 0$. The generalized "
+            rf"forces are all conservative, ${Q_}_j = -\partial {V_}/\partial q_j$ (eq. 31), "
+            f"and enter through ${V_}$."
+        )
+    return Step("forces", "Generalized forces", text + letters_note(model, "Q"), lines)
