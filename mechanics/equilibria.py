@@ -1657,8 +1657,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             )
         return (
             "marginal",
-            "every coordinate is free: no force acts at rest in any direction ($K = 0$), so every "
-            f"nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
+            "every coordinate is free: no force acts at rest in any direction ($K$ vanishes), so "
+            f"every nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
             lam,
             vecs,
         )
