@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from mechanics.model import T as t
+from mechanics.model import physical_limit_errors
 from mechanics.spec import SpecError
 
 #: States tried: M must be singular at all of them to blame the parameters.
@@ -73,7 +74,10 @@ def _overflowing(values: dict[str, float]) -> dict[str, str]:
 
 def check_masses(model, values: dict[str, float]) -> None:
     """Every body's mass, evaluated at these parameters, must be a positive number: a mass
-    written as an expression ("m - 2", "-1*m") escapes the per-parameter sign checks."""
+    written as an expression ("m - 2", "-1*m") escapes the per-parameter sign checks. The other
+    physical limits (stiffness, damping, rest length, gravity ≥ 0, a possible inertia tensor)
+    are checked here too, so every caller that takes request parameters (/equilibria beside
+    /simulate) refuses the same values."""
     numbers = {model.params[k]: sp.Float(v) for k, v in values.items()}
     errors = []
     for i, b in enumerate(model.bodies):
@@ -85,6 +89,7 @@ def check_masses(model, values: dict[str, float]) -> None:
             alone = str(b.mass) if b.mass in model.params.values() else None
             field = f"parameters.{alone}" if alone else f"bodies[{i}].mass"
             errors.append({"field": field, "message": f"must be > 0: {b.name}'s mass is {mass:g}"})
+    errors += physical_limit_errors(model, values)
     if errors:
         raise SpecError(errors)
 

@@ -45,6 +45,7 @@ from mechanics.check import check, expected_quantity
 from mechanics.derive import Derivation
 from mechanics.expr import ExprError, to_latex
 from mechanics.model import T as t
+from mechanics.model import physical_limit_errors
 from mechanics.numeric import _MATH, _NUMPY, StopFunction, _args, _plain, compile_derivation
 from mechanics.spec import SpecError
 from mechanics.steps import partial
@@ -376,6 +377,7 @@ def initial_state(
     if errors:
         raise SpecError(errors)
     values = {**spec.parameters, **parameters}
+    errors += physical_limit_errors(d.model, values)  # as /simulate: k − 3 < 0 at k = 1
     state = {**spec.initial, **initial}
     for q in spec.positive_coordinates:  # as /simulate: the derivation took q > 0 (r = √r²)
         if state.get(q, 0.0) <= 0:
