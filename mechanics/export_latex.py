@@ -80,6 +80,7 @@ MATH_WORDS = frozenset(
     | {"lvert", "rvert", "lVert", "rVert", "langle", "rangle", "lfloor", "rfloor", "lceil"}
     | {"rceil", "max", "min", "sgn", "mod", "operatorname", "Re", "Im", "in", "propto"}
     | {"Rightarrow", "leftarrow", "surd", "det"}
+    | {"mathcal"}  # 𝓛, 𝒯, 𝒱, 𝓔, 𝒬: the energies when a parameter has their letter
 )
 #: Environments an equation may open (sympy's matrices, piecewise's cases).
 MATH_ENVIRONMENTS = frozenset({"matrix", "pmatrix", "bmatrix", "smallmatrix", "cases", "array"})

@@ -163,6 +163,8 @@ def test_safe_math_accepts_sympys_latex():
         sp.latex(sp.sqrt(sp.Abs(sp.cos(theta) - sp.Symbol("omega")))),
         r"\vec{F}_{g,\text{bob\_1}} = - g m\hat{\jmath}",
         r"\frac{\partial L}{\partial \dot{\theta}} = m l^{2} \dot{\theta}",
+        # a scene with a length L writes its Lagrangian as a script L (steps/energy.py)
+        r"\mathcal{L} = \frac{L m \dot{\theta}^{2}}{2}",
     ]
     for latex in cases:
         assert safe_math(latex), latex
