@@ -74,3 +74,28 @@ def test_a_negative_stiffness_parameter_is_named(client, url):
     assert refused(post(client, url, {"k": -5.0}, scene_id="spring_mass_damper")) == [
         "parameters.k"
     ]
+
+
+@pytest.mark.parametrize(
+    "body, field",
+    [
+        ({"t_end": True}, "t_end"),
+        ({"parameters": {"m": True}}, "parameters.m"),
+        ({"initial": {"theta": False}}, "initial.theta"),
+        ({"method": "rk4", "dt": True}, "dt"),
+        ({"rtol": True}, "rtol"),
+    ],
+)
+def test_json_true_is_not_a_number_in_a_share_link(client, body, field):
+    """JSON true read as 1.0 would share a state nobody asked for: the share endpoint is as
+    strict as /simulate (app/schemas.py's Finite)."""
+    r = client.post("/api/v1/export/share", json={"scene_id": "simple_pendulum", **body})
+    assert refused(r) == [field]
+
+
+def test_a_share_link_with_numbers_still_works(client):
+    body = {"scene_id": "simple_pendulum", "t_end": 5, "parameters": {"m": 2}, "rtol": 1e-8}
+    r = client.post("/api/v1/export/share", json=body)
+    assert r.status_code == 200, r.text
+    state = client.get(r.json()["api"]).json()
+    assert state["t_end"] == 5 and state["parameters"] == {"m": 2.0}

@@ -29,7 +29,14 @@ from app import derivations
 from app.errors import readable
 from app.routes.scenes import unknown_scene
 from app.routes.simulate import simulation_answer
-from app.schemas import DeriveRequest, MethodName, SceneId, SimulateRequest, ValidationErrors
+from app.schemas import (
+    DeriveRequest,
+    Finite,
+    MethodName,
+    SceneId,
+    SimulateRequest,
+    ValidationErrors,
+)
 from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
 from mechanics.export_share import (
     PAGE_SETTINGS,
@@ -62,8 +69,6 @@ TOML = "application/toml; charset=utf-8"
 #: Longest a page query string may be for the GET exports (characters): a scene has at most
 #: 40 parameters and 12 initial values, each well under 60 characters.
 MAX_QUERY = 4096
-
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 
 
 def _named(pattern: str, what: str) -> AfterValidator:
@@ -415,13 +420,13 @@ class ShareState(DeriveRequest):
         },
     )
 
-    parameters: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_PARAMETERS)] = {}
-    initial: Annotated[dict[StateName, FiniteFloat], Field(max_length=2 * MAX_COORDINATES)] = {}
+    parameters: Annotated[dict[Name, Finite], Field(max_length=MAX_PARAMETERS)] = {}
+    initial: Annotated[dict[StateName, Finite], Field(max_length=2 * MAX_COORDINATES)] = {}
     method: MethodName = "dop853_c"  # type: ignore[valid-type]
-    rtol: FiniteFloat | None = Field(default=None, ge=1e-14, le=0.1)
-    atol: FiniteFloat | None = Field(default=None, ge=1e-16, le=1.0)
-    dt: FiniteFloat | None = Field(default=None, gt=0, le=1000)
-    t_end: FiniteFloat = Field(
+    rtol: Finite | None = Field(default=None, ge=1e-14, le=0.1)
+    atol: Finite | None = Field(default=None, ge=1e-16, le=1.0)
+    dt: Finite | None = Field(default=None, gt=0, le=1000)
+    t_end: Finite = Field(
         default=10.0,
         ge=PAGE_T_END[0],
         le=PAGE_T_END[1],
