@@ -435,8 +435,16 @@ class FairGate:
             self._running[ticket.client] += 1
 
     def _busy(self, client: str, seconds: float, what: str) -> str:
+        """Under the lock, this ticket already out of the queue: the client's tickets still in
+        it are the ones waiting behind (ten sent at once are not "1 running")."""
+        queued = sum(1 for ticket in self._waiting if ticket.client == client)
         return busy_message(
-            self._running[client], self.per_client, seconds, what, f"no {what} could start"
+            self._running[client],
+            self.per_client,
+            seconds,
+            what,
+            f"no {what} could start",
+            queued=queued,
         )
 
 

@@ -91,6 +91,34 @@ def test_gate_busy_refusal_and_arrival_order():
     run_in_thread(scenario)
 
 
+def test_gate_refusal_counts_the_clients_other_waiting_runs():
+    """One running and two more of the same client waiting: the one that gives up says so (the
+    count is the test's own setup, not read back from the gate)."""
+
+    async def scenario():
+        gate = FairGate(total=1, per_client=1)
+        release = asyncio.Event()
+
+        async def run(client, seconds=5.0):
+            async with gate.turn(client, seconds, "simulation"):
+                await release.wait()
+
+        holder = asyncio.create_task(run("a"))
+        await asyncio.sleep(0.01)
+        behind = [asyncio.create_task(run("a")) for _ in range(2)]
+        other = asyncio.create_task(run("b"))  # another client's wait is not counted
+        await asyncio.sleep(0.01)
+        with pytest.raises(BudgetExceeded) as refused:
+            await run("a", seconds=0.1)
+        said = str(refused.value)
+        assert "you already have 1 simulation running" in said
+        assert "and 2 more waiting" in said
+        release.set()
+        await asyncio.gather(holder, *behind, other)
+
+    run_in_thread(scenario)
+
+
 @pytest.fixture
 def server(monkeypatch):
     """A uvicorn server on a free loopback port in a thread, with a gate of 2 runs, 1 per
