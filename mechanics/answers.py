@@ -99,6 +99,8 @@ def to_convention_mapped(
         raise ExprError("expected text", field=field)
     if len(text) > MAX_LENGTH:
         raise ExprError(f"answer longer than {MAX_LENGTH} characters", field=field)
+    coordinates = list(coordinates)
+    example = coordinates[0] if coordinates else "x"  # what a refusal writes as the argument
     coordinates, known = set(coordinates), set(known)
     vocabulary = known | set(FUNCTIONS) | {"pi"}
     typed = text
@@ -106,9 +108,24 @@ def to_convention_mapped(
     origin.append(len(typed))
     out: list[tuple[str, str, int]] = []  # (kind, text, where it was typed)
     power = None  # sin^2 seen: (its exponent, where), waiting for the argument
+    function = ""  # the function name of that sin^2, for the refusal to name it
     closes: list[tuple[int, str, int]] = []  # (depth, exponent, where): sin^2( ... ) ** 2
+    # `cos θ` just read with no parentheses: (cos, or cos^2, and where θ is in out). What may
+    # follow decides if the text reads one way only. A power never does (`cos θ^3`: cos³θ or
+    # cos(θ³)?); a factor does after a coordinate (`sin θ φ'`, `cos θ (1 - cos θ)`: a product,
+    # as the notes write sin²θ φ̇²), not after a number or a parameter (`sin 2 θ`, `cos w t`:
+    # cos(w t) to the student, cos(w)·t to a parser)
+    bare: tuple[str, int] | None = None
     depth = 0
     pos = 0
+
+    def power_refused(at: int) -> ExprError:
+        return ExprError(_function_power(function, example), field=field, position=at)
+
+    def argument_refused(after: str, at: int) -> ExprError:
+        fn, atom = bare[0], out[bare[1]][1]
+        return ExprError(_ambiguous_argument(fn, atom, after), field=field, position=at)
+
     while pos < len(text):
         m = _TOKEN.match(text, pos)
         if not m:
@@ -122,33 +139,46 @@ def to_convention_mapped(
             continue
         if kind in ("prime", "mark"):
             order = len(value) if kind == "prime" else (1 if value == DOT else 2)
-            if not out or out[-1][0] != "name" or out[-1][1] not in coordinates:
+            # cos θ' is cos(θ'): the prime belongs to the argument just wrapped
+            k = bare[1] if bare and out[-1][1] == ")" else len(out) - 1
+            if not out or out[k][0] != "name" or out[k][1] not in coordinates:
                 raise ExprError(
                     "a prime or dot must follow a coordinate name",
                     field=field,
                     position=origin[m.start()],
                 )
-            out[-1] = ("name", out[-1][1] + ("_dot" if order == 1 else "_ddot"), out[-1][2])
+            out[k] = ("name", out[k][1] + ("_dot" if order == 1 else "_ddot"), out[k][2])
             continue
         if kind == "op" and value == "^":
             value = "**"
         at = origin[m.start()]
+        if bare is not None:  # cos θ, then: an operator is unambiguous, a power or a factor not
+            if kind == "op" and value == "**":
+                raise argument_refused("^" + _next_token(text, pos), at)
+            product = out[bare[1]][1] in coordinates
+            if kind == "num" or (value == "(" and not product):
+                raise argument_refused("(...)" if value == "(" else value, at)
+            if kind == "op":
+                bare = None
         if power == "":  # sin^ was the last thing: a whole number must come
             if kind != "num" or not value.isdigit():
-                raise ExprError(_FUNCTION_POWER, field=field, position=at)
+                raise power_refused(at)
             power = (value, at)
             continue
         if kind == "op" and value == "**" and out and out[-1][0] == "name":
             if out[-1][1] in FUNCTIONS:  # sin^2(θ), sin^2 θ: the notes' sin²θ is sin(θ)^2
+                function = out[-1][1]
                 if power is not None:  # sin^2^2: no argument yet, a second power
-                    raise ExprError(_FUNCTION_POWER, field=field, position=at)
+                    raise power_refused(at)
                 power = ""
+                # (sin θ ** 2) is one operand: sin^2(θ)^3 is (sin²θ)³, not sin θ ** (2 ** 3)
+                out.insert(len(out) - 1, ("op", "(", out[-1][2]))
                 continue
         if power is not None:
             if value == "(":
                 closes.append((depth, *power))
             elif kind not in ("num", "name"):
-                raise ExprError(_FUNCTION_POWER, field=field, position=at)
+                raise power_refused(at)
         if kind == "name" and _is_time_derivative(out, value, typed, known):
             if text[m.end() :].lstrip()[:1] != "(":
                 raise ExprError(_DDT_PARENTHESES, field=field, position=origin[m.start()])
@@ -165,14 +195,26 @@ def to_convention_mapped(
             except ExprError as exc:
                 raise ExprError(exc.message, field=field, position=origin[m.start()]) from None
             for k, piece in enumerate(pieces):
-                _append(out, "name", piece, origin[m.start()])
-                if k == 0 and power is not None and power != "":  # sin^2 θ: sin(θ) ** 2
-                    out += [("op", "**", power[1]), ("num", power[0], power[1])]
+                if bare is not None:
+                    if piece not in FUNCTIONS and out[bare[1]][1] not in coordinates:
+                        raise argument_refused(piece, at)  # cos w t: cos(w) t or cos(w t)?
+                    bare = None  # sin θ cos θ, sin θ φ'
+                wraps = _wraps(out, kind)
+                _append(out, "name", piece, at)
+                if wraps:
+                    bare = (out[-4][1], len(out) - 2)
+                if k == 0 and power is not None and power != "":  # sin^2 θ: (sin(θ) ** 2)
+                    bare = (f"{function}^{power[0]}", len(out) - 2)
+                    out += _power(*power)
                     power = None
             continue
-        _append(out, kind, value, origin[m.start()])
+        wraps = _wraps(out, kind)
+        _append(out, kind, value, at)
+        if wraps:
+            bare = (out[-4][1], len(out) - 2)
         if kind == "num" and power is not None:  # sin^2 3: the one atom taken
-            out += [("op", "**", power[1]), ("num", power[0], power[1])]
+            bare = (f"{function}^{power[0]}", len(out) - 2)
+            out += _power(*power)
             power = None
         elif value == "(":
             depth += 1
@@ -182,9 +224,9 @@ def to_convention_mapped(
             depth -= 1
             if closes and closes[-1][0] == depth:
                 _, exponent, where_typed = closes.pop()
-                out += [("op", "**", where_typed), ("num", exponent, where_typed)]
+                out += _power(exponent, where_typed)
     if power is not None:
-        raise ExprError(_FUNCTION_POWER, field=field, position=len(typed))
+        raise power_refused(len(typed))
     result: list[str] = []
     where: list[int] = []
     for k, (_, value, at) in enumerate(out):
@@ -197,10 +239,54 @@ def to_convention_mapped(
     return "".join(result), where
 
 
-_FUNCTION_POWER = (
-    "write sin^2(theta) (or sin(theta)^2) for the square of sin θ: after sin^ comes a whole "
-    "number, then the argument; the inverse is asin(...), the reciprocal 1/sin(...)"
-)
+def _function_power(function: str, argument: str) -> str:
+    """The refusal of a power after a function name the reader cannot take, naming the function
+    the student typed (cos^-1 θ is about cos, not sin)."""
+    inverse = f"the inverse is a{function}(...), " if f"a{function}" in FUNCTIONS else ""
+    return (
+        f"write {function}^2({argument}) (or {function}({argument})^2) for the square of "
+        f"{function}({argument}): after {function}^ comes a whole number, then the argument; "
+        f"{inverse}the reciprocal 1/{function}(...)"
+    )
+
+
+def _ambiguous_argument(function: str, argument: str, after: str) -> str:
+    """The refusal of a function without parentheses followed by a power or a factor: `cos θ^3`
+    is cos³θ to some and cos(θ³) to others, `sin 2 θ` is sin(2θ) or sin(2)·θ. Either reading
+    would judge some student wrongly, so the student says which."""
+    if after.startswith("^"):
+        one, other = f"{function}({argument}){after}", f"{function}({argument}{after})"
+    else:
+        one, other = f"{function}({argument} {after})", f"{function}({argument}) {after}"
+    return (
+        f"'{function} {argument}' followed by '{after}' can be read two ways: put the "
+        f"argument of {function.split('^')[0]} in parentheses, {one} or {other}"
+    )
+
+
+def _next_token(text: str, pos: int) -> str:
+    """The token after `pos` (an exponent, to quote it back), or 'n' when it is no atom."""
+    m = _TOKEN.match(text, pos)
+    while m and m.lastgroup == "space":
+        m = _TOKEN.match(text, m.end())
+    return m.group() if m and m.lastgroup in ("num", "name") else "n"
+
+
+def _power(exponent: str, at: int) -> list[tuple[str, str, int]]:
+    """`** n )`: closes the '(' put before the function name, so sin^2 θ is one operand."""
+    return [("op", "**", at), ("num", exponent, at), ("op", ")", at)]
+
+
+def _wraps(out: list[tuple[str, str, int]], kind: str) -> bool:
+    """Will `_append` read this atom as the argument of the function just before it?"""
+    return (
+        kind in ("num", "name")
+        and bool(out)
+        and out[-1][:1] == ("name",)
+        and (out[-1][1] in FUNCTIONS)
+    )
+
+
 _DDT_PARENTHESES = (
     "d/dt needs its expression in parentheses: d/dt(m l^2 theta'), or write the derivative "
     "out with theta' and theta''"
@@ -251,7 +337,7 @@ def _append(out: list[tuple[str, str, int]], kind: str, value: str, at: int) -> 
 
     A function written without parentheses takes the one atom after it: `cos θ` -> cos(theta).
     """
-    if out and out[-1][0] == "name" and out[-1][1] in FUNCTIONS and kind in ("num", "name"):
+    if _wraps(out, kind):
         out += [("op", "(", at), (kind, value, at), ("op", ")", at)]
         return
     if out:
