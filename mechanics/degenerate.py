@@ -85,7 +85,7 @@ def check_masses(model, values: dict[str, float]) -> None:
             mass = float(b.mass.xreplace(numbers))
         except (TypeError, ValueError):
             continue  # depends on a coordinate or t: the mass matrix check decides
-        if not mass > 0:
+        if not mass > 0 and not mass < 0:  # a negative mass: physical_limit_errors says it
             alone = str(b.mass) if b.mass in model.params.values() else None
             field = f"parameters.{alone}" if alone else f"bodies[{i}].mass"
             errors.append({"field": field, "message": f"must be > 0: {b.name}'s mass is {mass:g}"})

@@ -277,6 +277,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
     bodies: list[BodyInfo] = []
     for i, b in enumerate(spec.bodies):
         mass = expr(b.mass, f"bodies[{i}].mass")
+        limits.append((f"bodies[{i}].mass", f"{b.name}'s mass", mass))
         info = BodyInfo(b.name, b.kind, mass, points[b.name], positions[b.name], natural[b.name])
         if b.kind == "rigid_body":
             fr = frame_of(b.frame)
@@ -436,7 +437,8 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
 
     The per-parameter sign checks see only a parameter standing alone (k = "k"); written as a
     number or an expression ("-5", "k - 3", "-k") a negative stiffness, damping coefficient,
-    rest length or gravity went through and the run pumped energy in with no warning. A central
+    rest length or gravity went through and the run pumped energy in with no warning, and a
+    negative mass ("m - 2" at m = 1) was blamed on the initial state. A central
     inertia tensor must be positive semidefinite with principal moments obeying the triangle
     inequality (I₁ + I₂ ≥ I₃: ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(z² + x²) dm). A value that
     depends on the state or on t is left to the mass-matrix and run checks.
@@ -464,10 +466,13 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
             else ""
         )
         shown = "" if alone or value.is_number else f" ({to_plain(value)} at these parameters)"
+        # a mass of 0 is the mass matrix's to refuse (it names the coordinate left without
+        # inertia); a negative one is no body at all
+        bound = "> 0" if where.endswith(".mass") else "≥ 0"
         errors.append(
             {
                 "field": f"parameters.{alone}" if alone else where,
-                "message": f"must be ≥ 0: {what} is {x:g}{shown}{hint}",
+                "message": f"must be {bound}: {what} is {x:g}{shown}{hint}",
             }
         )
     return errors

@@ -99,3 +99,15 @@ def test_a_share_link_with_numbers_still_works(client):
     assert r.status_code == 200, r.text
     state = client.get(r.json()["api"]).json()
     assert state["t_end"] == 5 and state["parameters"] == {"m": 2.0}
+
+
+@pytest.mark.parametrize("url", ENDPOINTS)
+def test_a_mass_negative_at_the_request_values_is_refused(client, url):
+    """m − 2 at m = 1 is a mass of −1: named as the body's mass, not as a singular start."""
+    spec = copy.deepcopy(SPRING)
+    spec["bodies"][0]["mass"] = "m - 2"
+    spec["parameters"]["m"] = 3.0
+    assert post(client, url, {"m": 2.5}, spec).status_code == 200
+    r = post(client, url, {"m": 1.0}, spec)
+    assert refused(r) == ["bodies[0].mass"]
+    assert "-1" in r.json()["detail"][0]["message"]
