@@ -34,7 +34,8 @@ const frames = [];
 for (let i = 0; i < g.n; i += 4) {
   const shapes = sceneShapes(g, view, i, { radius: 16, trail: 0, scaleBar: true, font });
   const bar = shapes.find((s) => s.t === "text" && / c?m$/.test(s.text) && s.size === font - 1);
-  const bodies = g.bodies.map((b) => [b.name, ...view.project(g.at(b.name, i)).slice(0, 2), 16 * g.size[b.name]]);
+  const bodies = g.bodies.map((b) =>
+    [b.name, ...view.project(g.at(b.name, i)).slice(0, 2), 16 * g.size[b.name]]);
   frames.push({ i, bar: bar ?? null, bodies });
 }
 console.log(JSON.stringify({ frames, w: view.w, h: view.h, is3D: g.is3D }));
