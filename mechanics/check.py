@@ -592,25 +592,45 @@ class _Judge:
         """A Q_j that is Q_j^NC plus −∂V/∂q_j: the notes' eq. 31 sums every force, gravity and
         springs included, but the forces step asks only for the non-conservative part (the
         rest is in V). Saying 'Extra term' would hide that the student's physics is right;
-        it is still not the quantity asked for. Proved, not sampled."""
+        it is still not the quantity asked for. Proved, not sampled. When the answer holds that
+        part and something else wrong besides (−k (x − L0) for −k x), the part is named so and
+        the rest of the answer is judged on its own: 'Extra term −kx' alone would hide the why.
+        """
         q = self.m.q[self.j]
         conservative = -partial(self.d.work.V, q, self.m)
         if conservative == 0:
             return False
         rest = self.given - self.expected - conservative
-        if not self.same(rest, sp.S.Zero) or zero_proof(rest, self.m) is not True:
+        whole = self.same(rest, sp.S.Zero) and zero_proof(rest, self.m) is True
+        if not whole and not self._holds_terms(self.given - self.expected, conservative):
             return False
         spec = self.m.spec
         sources = [w for w, has in (("gravity", spec.gravity), ("springs", spec.springs)) if has]
         name = to_latex(q)
         shown = inline(_tidy(conservative, self.m))[1:-1]
+        ending = "."
+        if whole and self.expected != 0:
+            ending = "; without that part your answer would be right."
+        elif not whole:
+            ending = "; without that part, your answer still differs:"
         fb.append(
             f"Your answer includes the conservative part $-\\partial V/\\partial {name} = "
             f"{shown}$ ({'/'.join(sources) or 'gravity/springs'}), which is already in V: only "
-            f"the non-conservative part $Q_{{{name}}}^{{NC}}$ is asked for"
-            + ("." if self.expected == 0 else "; without that part your answer would be right.")
+            f"the non-conservative part $Q_{{{name}}}^{{NC}}$ is asked for" + ending
         )
+        if not whole:
+            self._diagnose(self.given - conservative, self.expected, fb)
         return True
+
+    def _holds_terms(self, expr: sp.Expr, part: sp.Expr) -> bool:
+        """Does ``expr``, term by term (canonical monomials, coefficients proved equal), hold
+        every term of ``part``, and something besides?"""
+        whole, piece = self._canonical(expr), self._canonical(part)
+        if not piece or len(whole) + len(piece) > MAX_TERMS or len(whole) <= len(piece):
+            return False
+        return all(
+            mono in whole and sp.simplify(whole[mono] - coeff) == 0 for mono, coeff in piece.items()
+        )
 
     def _shifted_datum(self, fb: list[str]) -> bool:
         """A spring's V written k (x − L0)²/2 (the notes' eq. 27, stretch = length − rest
@@ -1050,13 +1070,16 @@ class _Judge:
                 size = math.nan
             if math.isfinite(size) and size > 1e-30:
                 return ""
-        zeros, poles = [], []
+        zeros, poles = [], []  # each with its power: (l − 1)² is named so, not l − 1
         for form in (factor, sp.factor_terms(sp.together(factor))):  # as written, then factored
             for part in sp.Mul.make_args(form):
                 base, exponent = part.as_base_exp()
                 if base.is_number or base.xreplace(values).xreplace(motion) != 0:
                     continue
-                (poles if exponent.is_negative else zeros).append(base)
+                if exponent.is_negative:
+                    poles.append(sp.Pow(base, -exponent))
+                else:
+                    zeros.append(part)
             if zeros or poles:
                 break
         if zeros and poles:
