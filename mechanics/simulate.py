@@ -616,12 +616,18 @@ def _accuracy_warning(
             lo, hi = lo + start, hi + start
         why = "a symplectic method's bounded error" if method.symplectic else "a bounded error"
         return (
-            f"{name} oscillates between {lo:.3g}{unit} and {hi:.3g}{unit}, within {of_scale}, "
+            f"{name} oscillates between {_apart(lo, hi, lo)}{unit} and {_apart(hi, lo, hi)}{unit}, "
+            f"within {of_scale}, "
             f"and does not grow over the run: {why}; {shrink} shrinks it."
         )
-    base = 0.0 if start is None else start
-    moved = "grew" if error[worst] > 0 else "fell"
-    change = f"{moved} from {base:.3g}{unit} to {base + float(error[worst]):.3g}{unit}"
+    if start is None:  # the balance: 0 for an exact run, so no "from"
+        change = f"reached {float(error[worst]):.3g}{unit}"
+    else:
+        end = start + float(error[worst])
+        moved = "grew" if error[worst] > 0 else "fell"
+        change = (
+            f"{moved} from {_apart(start, end, start)}{unit} to {_apart(start, end, end)}{unit}"
+        )
     when = f"by t = {t[worst]:.3g} s"
     if trend == "grows":
         if method.symplectic:
@@ -638,6 +644,14 @@ def _accuracy_warning(
             f"length of the run: {better}."
         )
     return f"{name} {change} {when}, {of_scale}: ask for {shrink} or a higher-order method."
+
+
+def _apart(a: float, b: float, x: float) -> str:
+    """x with the digits that tell a from b apart (E fell from −8.7312 J to −8.7225 J, not from
+    −8.73 J to −8.73 J), at least 3 significant."""
+    gap, size = abs(a - b), max(abs(a), abs(b))
+    digits = 3 if gap == 0 or size == 0 else max(3, min(12, math.ceil(math.log10(size / gap)) + 2))
+    return f"{x:.{digits}g}"
 
 
 #: A drift: the error's largest size over the run's second half exceeds the first half's by
