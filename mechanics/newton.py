@@ -1,12 +1,13 @@
 """Newton's method beside Lagrange's (notes I.A): Σ F = m a per particle, constraint forces kept.
 
-Each particle's balance m a = F + R is written along the unit vectors of the frame its position
-is natural in (polar for a pendulum). The constraint force R is the unknown Lagrange never needs:
+Each particle's balance m a = F + F_C is written along the unit vectors of the frame its position
+is natural in (polar for a pendulum). The constraint force F_C is the unknown Lagrange never needs:
 projected on the directions the particle may move (∂r/∂q_j) the balances give back the equations
-of motion (D'Alembert, eq. 19–20); projected on the other directions they give R itself, here
+of motion (D'Alembert, eq. 19–20); projected on the other directions they give F_C itself, here
 solved with q̈ from the equations of motion: the tension F_T(θ, θ̇) of a pendulum, the normal
-force of a hoop, the tension of the Atwood machine's string. A tension is written F_T, as in the
-free-body diagram: T is the kinetic energy.
+force F_N of a hoop, the tension F_T of the Atwood machine's string. Each is called what the
+free-body diagram calls it (`fbd.resultant_name`): one force, one name on both panels, and never
+a scene's parameter (R is a radius) nor the kinetic energy T.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from sympy.physics.vector import Vector
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
 from mechanics.steps import Line, Step, sub, tidy, vec_in, vec_line
-from mechanics.steps.fbd import body_forces, rod_anchor
+from mechanics.steps.fbd import body_forces, constraint_forces, resultant_name, rod_anchor
 
 
 @dataclass
@@ -30,12 +31,20 @@ class ConstraintForce:
     vector: Vector  # R = m a − ΣF, with q̈ from the equations of motion
     components: list[sp.Expr]  # along the natural frame's unit vectors
     support: tuple[str, sp.Expr] | None = None  # (point, tension toward it) for a rod or string
+    name: str = "F_C"  # as the free-body diagram names it: F_T, F_N, F_pin, or F_C (a resultant)
+    parts: tuple[str, ...] = ()  # the diagram's labels of the forces F_C sums, when several
+
+    @property
+    def label(self) -> str:
+        letter, _, index = self.name.partition("_")
+        return rf"\vec{{{letter}}}_{{{sub(index)},{sub(self.body)}}}"
 
 
 def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Expr]]:
     """Steps, the constraint force on every particle, and the equations Newton's method gives."""
     m = d.model
     acting = body_forces(m)
+    placed, _ = constraint_forces(m)
     solved = dict(zip(m.qdd, d.solved_accelerations, strict=True))
     balance_lines: list[Line] = []
     forces: list[ConstraintForce] = []
@@ -72,7 +81,13 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
         R_nice, comps = vec_in(R_solved, frame, m)
         if potential_force is not None:
             support = _support_force(b, R_nice, m)
-            forces.append(ConstraintForce(b.name, frame, R_nice, comps, support))
+            name = resultant_name(placed[b.name])
+            # a rod's pull is labelled by the rod (the same label on both its ends, opposite
+            # forces), so a sum of labels is written only over the body's own forces
+            own = [f["label"] for f in placed[b.name] if f.get("part") == "rest"]
+            whole = name == "F_C" and len(own) == len(placed[b.name])
+            parts = tuple(own) if whole else ()
+            forces.append(ConstraintForce(b.name, frame, R_nice, comps, support, name, parts))
             if support is not None and frame == "N":
                 balance_lines += _polar_lines(b, support[0], b.mass * a, applied, m)
         if b.frame is not None:  # Σ M_G = dH_G/dt (eq. 11); the constraint moment is the rest
@@ -156,13 +171,14 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
     m = d.model
     text = (
         "For each particle write Σ F = m a (eq. 10) along the unit vectors of its natural "
-        "frame, with the constraint force R as an unknown: m a = ΣF_applied + R."
+        r"frame, with the constraint force as an unknown: $m\vec a = \sum \vec F + \vec F_C$, "
+        r"$\vec F_C$ named as in the free-body diagram (the rope's or rod's $\vec F_T$, a "
+        r"normal force $\vec F_N$) when it is one force there."
     )
     constraint_lines = []
     for f in forces:
-        line = vec_line(
-            rf"\vec{{R}}_{{{sub(f.body)}}}", f.vector, f.frame, m, f"constraint force on {f.body}"
-        )
+        lhs = f.label + (" = " + " + ".join(f.parts) if len(f.parts) > 1 else "")
+        line = vec_line(lhs, f.vector, f.frame, m, f"constraint force on {f.body}")
         constraint_lines.append(line)
         if f.support is not None:
             tension = f.support[1]
@@ -176,7 +192,8 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
     solved_text = (
         "Projected on the directions the particle may move (∂r/∂q_j) the balances are "
         "the equations of motion — the same as Lagrange's (D'Alembert, eq. 20). "
-        "Projected on the others they give R, here with q̈ from the equations of "
+        "Projected on the others they give the constraint force, here with q̈ from the "
+        "equations of "
         "motion: the force the constraint must supply."
     )
     return [

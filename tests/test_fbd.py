@@ -41,7 +41,7 @@ def test_rolling_disk_has_normal_force_and_static_friction_at_the_contact():
     """By hand: m a = m g sin α + f along the slope, m g cos α = N across it, with
     a = (2/3) g sin α, so f = m a − m g sin α = −(1/3) m g sin α (up the slope)."""
     forces = placed("rolling_disk")["disk"]
-    assert [f["name"] for f in forces] == ["N", "f_s"]
+    assert [f["name"] for f in forces] == ["F_N", "F_f"]
     m, R, alpha, g = 1.0, 0.3, 0.5, 9.81
     r = run("rolling_disk")
     x = np.array(r["q"]["x"])
@@ -59,10 +59,10 @@ def test_rolling_disk_has_normal_force_and_static_friction_at_the_contact():
         )
         for f in forces
     }
-    assert np.allclose(along["N"], normal) and np.allclose(along["f_s"], down_slope)
+    assert np.allclose(along["F_N"], normal) and np.allclose(along["F_f"], down_slope)
     total = xyz(r["constraint_forces"]["disk"])
-    assert np.allclose(total @ along["f_s"], -m * g * np.sin(alpha) / 3, rtol=1e-8)
-    assert np.allclose(total @ along["N"], m * g * np.cos(alpha), rtol=1e-8)
+    assert np.allclose(total @ along["F_f"], -m * g * np.sin(alpha) / 3, rtol=1e-8)
+    assert np.allclose(total @ along["F_N"], m * g * np.cos(alpha), rtol=1e-8)
     assert "tension" not in r["constraint_forces"]["disk"]
 
 
@@ -70,7 +70,7 @@ def test_physical_pendulum_pin_reaction_at_the_pin_by_newton_euler():
     """Rod of length l about its end O, G at l/2: θ̈ = −(3g/2l) sin θ, and m a_G = m g + R gives
     R·ê_r = −m (g cos θ + l θ̇²/2) (a pull toward O), R·ê_θ = m g sin θ / 4."""
     (pin,) = placed("physical_pendulum")["rod"]
-    assert pin["name"] == "R" and "pin" in pin["what"]
+    assert pin["name"] == "F_pin" and "pin" in pin["what"]
     assert pin["at"] == ["0", "0", "0"]  # O, not the centre of mass
     m, length, g = 1.0, 1.0, 9.81
     r = run("physical_pendulum")
@@ -85,7 +85,7 @@ def test_physical_pendulum_pin_reaction_at_the_pin_by_newton_euler():
 
 def test_bead_on_a_hoop_feels_a_normal_force_not_a_tension():
     (normal,) = placed("bead_on_hoop")["bead"]
-    assert normal["name"] == "N" and normal["at"] == "bead"
+    assert normal["name"] == "F_N" and normal["at"] == "bead"
     _, forces, _ = newton(derivation_of_scene("bead_on_hoop"))
     assert forces[0].support is None  # no "tension" toward O
     r = run("bead_on_hoop")

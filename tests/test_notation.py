@@ -166,7 +166,7 @@ def test_the_frame_n_is_defined_where_it_is_first_used(scene_id):
 
 def test_the_rolling_disks_normal_force_is_a_vector_with_its_body():
     (note,) = steps(derive_scene("rolling_disk"))["fbd"]["data"]["constraints"]
-    assert r"$\vec{N}_{\text{disk}}$" in note and r"$\vec{f}_{s,\text{disk}}$" in note
+    assert r"$\vec{F}_{N,\text{disk}}$" in note and r"$\vec{F}_{f,\text{disk}}$" in note
 
 
 # ---------------------------------------------------------------------------- 4. k, M, W

@@ -21,7 +21,7 @@ def explicit_time(expr: sp.Expr, model: Model) -> bool:
 
 
 def nc_power(model: Model, work: Work) -> sp.Expr:
-    """P = Σ_j Q_j q̇_j, the rate at which the non-conservative forces change h (= E when the
+    """P = Σ_j Q_j^NC q̇_j, the rate at which the non-conservative forces change h (= E when the
     constraints are fixed): dh/dt = P − ∂L/∂t (notes eq. 23). A Lorentz force q v × B has
     Q ≠ 0 but P = 0 (it does no work), so E is conserved as if no force acted."""
     if all(Q == 0 for Q in work.Q):
@@ -71,13 +71,15 @@ def conserved_quantities(model: Model, work: Work) -> Step:
             )
     work.conserved = found
     parts = []
-    power = rf"$\sum_j {Q_}_j \dot q_j$"
+    # Q_j^NC: the forces step's Q_j (eq. 31 over all forces) would add −∂V/∂q_j, whose power −dV/dt
+    # is already in E = T + V
+    power = rf"$\sum_j {Q_}_j^{{NC}} \dot q_j$"
     no_t = f"${L_}$ has no explicit $t$"
     if any(c["name"] == "energy" for c in found) and not no_nc:
         parts.append(
             f"{no_t}, and the non-conservative forces' power {power} simplifies to 0: they do "
             f"no work (gyroscopic, like a magnetic force), so ${E_} = {T_} + {V_}$ is conserved "
-            rf"($d{E_}/dt = \sum_j {Q_}_j \dot q_j = 0$, eq. 23)."
+            rf"($d{E_}/dt = \sum_j {Q_}_j^{{NC}} \dot q_j = 0$, eq. 23)."
         )
     elif any(c["name"] == "energy" for c in found):
         parts.append(
@@ -96,10 +98,19 @@ def conserved_quantities(model: Model, work: Work) -> Step:
             )
         )
     elif not no_work:
-        parts.append(
-            rf"Non-conservative forces do work: $d{E_}/dt = \sum_j {Q_}_j \dot q_j$, so ${E_}$ "
-            r"changes by $W^{NC}$ (eq. 23)."
-        )
+        if explicit_time(work.L, model):  # dh/dt = P − ∂L/∂t: E is not T + V's whole story
+            parts.append(
+                "Non-conservative forces do work and the constraints move: the Jacobi "
+                rf"integral $h = \sum_j \dot q_j\, \partial {L_}/\partial \dot q_j - {L_}$ "
+                rf"changes as $dh/dt = \sum_j {Q_}_j^{{NC}} \dot q_j - \partial {L_}/\partial t$ "
+                f"(eq. 23), and neither $h$ nor ${E_}$ is conserved."
+            )
+        else:
+            parts.append(
+                "Non-conservative forces do work: "
+                rf"$d{E_}/dt = \sum_j {Q_}_j^{{NC}} \dot q_j$, so ${E_}$ changes by "
+                r"$W^{NC}$ (eq. 23)."
+            )
     else:
         parts.append(
             f"${L_}$ depends explicitly on $t$: neither ${E_}$ nor the Jacobi integral is "

@@ -1,11 +1,12 @@
 """Step 1 (notes IV.A 1): the free-body diagram — every force on every body, frames, datum.
 
 Besides the applied forces, each body's constraint forces are named the way a textbook names them
-and placed where they act (`constraint_forces`): a rod's tension F_T at a bob, a track's or a wire's
-normal force N, a pin reaction R at the pin, the normal force N and static friction f_s at a
-rolling contact. The tension is F_T, never a bare T: T is the kinetic energy two steps later.
-Only the names, the points and the directions come from here (kinematics alone); the sizes are
-Newton's (`mechanics.newton`, R = m a − ΣF along a run).
+and placed where they act (`constraint_forces`), all of one family with the weight F_g: a rod's
+tension F_T at a bob, a track's or a wire's normal force F_N, a pin reaction F_pin at the pin, the
+normal force F_N and static friction F_f at a rolling contact, F_C for a resultant left unsplit.
+Never a bare letter: T is the kinetic energy, N the inertial frame, R a disk's radius or a frame's
+name in the scenes. Only the names, the points and the directions come from here (kinematics
+alone); the sizes are Newton's (`mechanics.newton`, F_C = m a − ΣF along a run).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
 from mechanics.steps.energy import letter
+from mechanics.steps.forces import derived_letter
 
 #: A kinematic quantity counts as zero when it is below this at every sampled state.
 ZERO = 1e-9
@@ -176,7 +178,7 @@ def _force(
     name: str, on: str, what: str, at: str | list[str], label_of: str | None = None, **how: Any
 ) -> dict[str, Any]:
     letter, _, index = name.partition("_")
-    label = rf"\vec{{{letter}}}_{{{index + ',' if index else ''}{sub(label_of or on)}}}"
+    label = rf"\vec{{{letter}}}_{{{sub(index) + ',' if index else ''}{sub(label_of or on)}}}"
     symbol = [letter, f"{index},{label_of or on}" if index else (label_of or on)]
     return {"name": name, "label": label, "symbol": symbol, "what": what, "on": on, "at": at, **how}
 
@@ -185,8 +187,8 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
     """A planar rigid body moved by one coordinate: its constraints act at the point at rest.
 
     The instantaneous centre P = G + ẑ × v_G / ω has zero velocity; if it is fixed in space it is
-    a pin (reaction R), else the body rolls on the path P traces (normal force N across it, static
-    friction f_s along it — no slip, so friction is static).
+    a pin (reaction F_pin), else the body rolls on the path P traces (normal force F_N across it,
+    static friction F_f along it — no slip, so friction is static).
     """
     moves = _moved_by(model, body.position, s)
     t = model.names["t"]
@@ -211,7 +213,7 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
     if s.zero(centre.diff(q, model.N)):
         pin = next((p for p, r in model.positions.items() if s.zero(r - centre)), None)
         where = f"the pin at {pin}" if pin else "the pin"
-        force = _force("R", name, f"pin reaction on {name}, at {where}", at, part="rest")
+        force = _force("F_pin", name, f"pin reaction on {name}, at {where}", at, part="rest")
         return [force], (
             f"the pin reaction ${force['label']}$ acts at {where}, a point of {name} that never "
             f"moves: its virtual displacement is zero, so ${force['label']}$ does no virtual "
@@ -224,7 +226,7 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
         normal = -normal
     forces = [
         _force(
-            "N",
+            "F_N",
             name,
             f"normal force on {name} at the contact",
             at,
@@ -232,7 +234,7 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
             along=_unit(normal, model),
         ),
         _force(
-            "f_s",
+            "F_f",
             name,
             f"static friction on {name} at the contact",
             at,
@@ -336,7 +338,7 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
             if not coupled and k < free:
                 where = "track" if k == 1 else "surface"
                 normal = _force(
-                    "N", name, f"normal force of the {where} on {name}", name, part="rest"
+                    "F_N", name, f"normal force of the {where} on {name}", name, part="rest"
                 )
                 own = ([normal], f"the {where}'s normal force ${normal['label']}$ is across it")
             elif coupled and _straight_rope(model, name, s):
@@ -345,7 +347,7 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
                 )
             elif coupled or k < free:
                 forces[name].append(
-                    _force("R", name, f"constraint force on {name}", name, part="rest")
+                    _force("F_C", name, f"constraint force on {name}", name, part="rest")
                 )
         elif not coupled and (contact := _rigid_contact(model, body, s)) is not None:
             forces[name] += contact[0]
@@ -355,7 +357,7 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
         else:
             forces[name].append(
                 _force(
-                    "R",
+                    "F_C",
                     name,
                     f"resultant of the constraint forces on "
                     f"{name} (drawn at its centre; a constraint moment too)",
@@ -402,6 +404,17 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
     return forces, notes
 
 
+def resultant_name(placed: list[dict[str, Any]]) -> str:
+    """The name of a body's whole constraint force (Newton's m a − ΣF) as the FBD calls it.
+
+    One force of its own and no rod pulling from it: that force's name (the Atwood rope's F_T, a
+    bead's F_N), so the Newton panel and the diagram say one name for one force; otherwise the
+    resultant F_C of the several the diagram draws (a rolling disk's F_N + F_f)."""
+    if len(placed) == 1 and placed[0].get("part") == "rest":
+        return placed[0]["name"]
+    return "F_C"
+
+
 def free_body_diagram(model: Model, work: Work) -> Step:
     """Forces as vectors, constraint forces named and placed, frames and datum.
 
@@ -409,14 +422,14 @@ def free_body_diagram(model: Model, work: Work) -> Step:
       ``bodies``: per body ``{"body", "kind", "free_directions", "forces", "constraint_forces"}``;
         ``forces`` are the applied ones (label, kind, plain, components in N);
         ``constraint_forces`` each ``{"name", "label", "what", "on", "at", "part", ...}``:
-        ``name`` as a textbook writes it (F_T tension of a rod or rope, N normal force, f_s static
-        friction, R pin reaction or an unnamed resultant; ``symbol``: its letter and subscript
+        ``name`` of the F family (F_T tension of a rod or rope, F_N normal force, F_f static
+        friction, F_pin pin reaction, F_C an unnamed resultant; ``symbol``: its letter and subscript
         in plain text, ``what``: in words), ``at`` where it acts: a place of the
         run's ``positions`` (a body, a point) or its N components as plain expressions in the
         coordinates and parameters (a pin, a rolling contact). Its size comes from Newton's
-        constraint force R_on = m a − ΣF of the run (`constraint_forces` of /simulate):
+        constraint force F_C = m a − ΣF of the run (`constraint_forces` of /simulate):
         ``part = "pull"``: the rod of body ``rod`` pulls this end toward ``rod`` with that rod's
-        tension; ``part = "rest"``: R_on less the pulls listed on the same body, projected on
+        tension; ``part = "rest"``: F_C less the pulls listed on the same body, projected on
         ``along`` (unit vector, N components) or on the direction ``toward`` a place when given.
       ``constraints``: one sentence per body on the virtual work of its constraint forces.
       ``datum``: where V = 0.
@@ -458,6 +471,7 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     heights = "every body at the height of O" if model.gravity is not None else ""
     rest = "every spring at its rest length" if model.springs else ""
     V = letter(model, "V")
+    Q_ = derived_letter(model, "Q")
     datum = (
         f"${V} = 0$ with {' and '.join(filter(None, [heights, rest]))}"
         if heights or rest
@@ -466,9 +480,9 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     text = (
         "Draw every force on every body, the constraint forces where they act. Weights, springs "
         f"and potentials are conservative and enter through ${V}$; dampers and applied forces do "
-        "non-conservative work and enter through $Q_j$. For ideal constraints the constraint "
-        "forces on all bodies together do no virtual work (notes eq. 18–20); on one body alone "
-        f"only when its constraints are its own. Datum: {datum}."
+        f"non-conservative work and enter through ${Q_}_j^{{NC}}$. For ideal constraints the "
+        "constraint forces on all bodies together do no virtual work (notes eq. 18–20); on one "
+        f"body alone only when its constraints are its own. Datum: {datum}."
     )
     if model.frames:  # ω_{D/N} below is the first place N appears
         first = next(iter(model.frames))

@@ -6,7 +6,7 @@ import sympy as sp
 
 from mechanics.expr import to_latex
 from mechanics.model import Model
-from mechanics.steps import Step, Work, eq_line, tidy
+from mechanics.steps import Step, Work, eq_line, partial, tidy
 from mechanics.steps.energy import ENERGY_LETTERS, letter
 
 #: E (the energy) and Q (the generalized forces) take a script form by energy.letter's rule.
@@ -60,8 +60,10 @@ def generalized_forces(model: Model, work: Work) -> Step:
     work.Q = Q
     Q_, V_ = derived_letter(model, "Q"), derived_letter(model, "V")
     L_, T_ = derived_letter(model, "L"), derived_letter(model, "T")
+    # the plain copy says NC as the LaTeX does: a bare Q_x = 0 reads as the whole Q_x
+    Q_plain = "Q" if Q_ == "Q" else "script_Q"
     lines = [
-        eq_line(f"Q_{name}", rf"{Q_}_{{{to_latex(qi)}}}^{{NC}}", Qj, f"Q_{name}")
+        eq_line(f"Q_{name}", rf"{Q_}_{{{to_latex(qi)}}}^{{NC}}", Qj, f"{Q_plain}_{name}^NC")
         for name, qi, Qj in zip(model.coordinate_names, model.q, Q, strict=True)
     ]
     # Eq. 31 sums every force, weights and springs too; those are in V already, and counted
@@ -80,7 +82,23 @@ def generalized_forces(model: Model, work: Work) -> Step:
     else:
         text = (
             f"No non-conservative force acts: every ${Q_}_j^{{NC}} = 0$. The generalized "
-            rf"forces are all conservative, ${Q_}_j = -\partial {V_}/\partial q_j$ (eq. 31), "
-            f"and enter through ${V_}$."
+            rf"forces of eq. 31 are then all conservative, ${Q_}_j = -\partial {V_}/\partial q_j$"
+            f"{_conservative_example(model, work, Q_, V_)}, and enter through ${V_}$, not here."
         )
     return Step("forces", "Generalized forces", text + letters_note(model, "Q"), lines)
+
+
+def _conservative_example(model: Model, work: Work, Q_: str, V_: str) -> str:
+    """', here Q_x = −∂V/∂x = g(m₁ − m₂)' for one coordinate: the sentence beside Q_x^NC = 0
+    then shows that the whole Q_x is not 0 (an Atwood machine's is the weights' difference)."""
+    if len(model.q) != 1:
+        return ""
+    q = model.q[0]
+    conservative = tidy(-partial(work.V, q, model), model)
+    if sp.count_ops(conservative) > 12:
+        return ""
+    x = to_latex(q)
+    return (
+        rf", here ${Q_}_{{{x}}} = -\partial {V_}/\partial {x} = {to_latex(conservative)}$"
+        rf" while ${Q_}_{{{x}}}^{{NC}} = 0$"
+    )

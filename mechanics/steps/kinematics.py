@@ -1,7 +1,9 @@
 """Step 3 (notes I.B, eq. 9, 15–16): positions and velocities of every body.
 
-A position written along a moving frame's unit vectors is differentiated by the transport
-theorem, v = (dr/dt)_F + ω_F/N × r, and the step shows both terms; sympy.physics.vector does the
+A position written along a turning frame B's unit vectors is differentiated by the transport
+theorem, v = (dr/dt)_B + ω_B/N × r (the notes' eq. 9 with their F our N): the relative rate is
+the one seen in B, the frame that turns; the step shows both terms, named by B as the model names
+it, so no F appears beside N; sympy.physics.vector does the
 same algebra, so the printed pieces and the velocity used for T agree by construction.
 """
 
@@ -16,6 +18,7 @@ from mechanics.steps import Line, Step, Work, sub, vec_line
 def kinematics(model: Model, work: Work) -> Step:
     lines: list[Line] = []
     transport = []
+    turning: list[str] = []  # the frames that turn, in the order their bodies come
     for b in model.bodies:
         natural = b.natural_frame
         r = b.position
@@ -43,6 +46,8 @@ def kinematics(model: Model, work: Work) -> Step:
                 )
             )
             transport.append(b.name)
+            if natural not in turning:
+                turning.append(natural)
         lines.append(
             vec_line(
                 rf"\vec{{v}}_{{{sub(b.name)}}}",
@@ -68,9 +73,16 @@ def kinematics(model: Model, work: Work) -> Step:
         r"vectors $\hat\imath, \hat\jmath, \hat k$; a subscript /N means relative to it."
     )
     if transport:
-        text += (
-            r" Where the frame turns, the transport theorem "
-            r"$\vec v = (d\vec r/dt)_F + \vec\omega \times \vec r$ (eq. 9) "
-            "gives the velocity."
+        theorem = ", ".join(
+            rf"$\vec v = (d\vec r/dt)_{{{sub(B)}}} + \vec\omega_{{{sub(B)}/N}} \times \vec r$"
+            + (f" for a body in {B}" if len(turning) > 1 else "")
+            for B in turning
         )
-    return Step("kinematics", "Kinematics", text, lines, {"transport": transport})
+        where = " and ".join(turning)
+        text += (
+            f" Frame{'s' if len(turning) > 1 else ''} {where} turn{'' if len(turning) > 1 else 's'}"
+            f": the transport theorem {theorem} (eq. 9, the notes' F being N) gives the velocity, "
+            r"the rate of $\vec r$ seen in the turning frame plus that frame's turning."
+        )
+    data = {"transport": transport, "transport_frames": turning}
+    return Step("kinematics", "Kinematics", text, lines, data)

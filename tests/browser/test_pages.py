@@ -334,9 +334,9 @@ def test_equilibria_are_listed_and_drawn(server, page):
 
 #: What each built-in scene's free-body diagram must name, per body, among its constraint forces.
 CONSTRAINT_NAMES = {
-    "rolling_disk": {"disk": ["N", "f_s"]},
-    "physical_pendulum": {"rod": ["R"]},
-    "bead_on_hoop": {"bead": ["N"]},
+    "rolling_disk": {"disk": ["F_N", "F_f"]},
+    "physical_pendulum": {"rod": ["F_pin"]},
+    "bead_on_hoop": {"bead": ["F_N"]},
     "simple_pendulum": {"bob": ["F_T"]},
     "atwood_machine": {"mass1": ["F_T"], "mass2": ["F_T"]},
     "double_pendulum": {"bob1": ["F_T", "F_T"], "bob2": ["F_T"]},
