@@ -601,7 +601,9 @@ class _Judge:
         if conservative == 0:
             return False
         rest = self.given - self.expected - conservative
-        whole = self.same(rest, sp.S.Zero) and zero_proof(rest, self.m) is True
+        whole = self.same(rest, sp.S.Zero)
+        if whole and zero_proof(rest, self.m) is not True:
+            return False
         if not whole and not self._holds_terms(self.given - self.expected, conservative):
             return False
         spec = self.m.spec
@@ -623,14 +625,19 @@ class _Judge:
         return True
 
     def _holds_terms(self, expr: sp.Expr, part: sp.Expr) -> bool:
-        """Does ``expr``, term by term (canonical monomials, coefficients proved equal), hold
-        every term of ``part``, and something besides?"""
+        """Does ``expr`` hold every term of ``part`` as written: each canonical monomial of
+        ``part`` is in ``expr`` with that coefficient, or with it as one of its summands
+        (−k x + 7 x is (7 − k) x, and holds −k x)?"""
         whole, piece = self._canonical(expr), self._canonical(part)
-        if not piece or len(whole) + len(piece) > MAX_TERMS or len(whole) <= len(piece):
+        if not piece or len(whole) + len(piece) > MAX_TERMS:
             return False
-        return all(
-            mono in whole and sp.simplify(whole[mono] - coeff) == 0 for mono, coeff in piece.items()
-        )
+        for mono, coeff in piece.items():
+            if mono not in whole:
+                return False
+            summands = set(sp.Add.make_args(sp.expand(whole[mono])))
+            if not set(sp.Add.make_args(sp.expand(coeff))) <= summands:
+                return False
+        return True
 
     def _shifted_datum(self, fb: list[str]) -> bool:
         """A spring's V written k (x − L0)²/2 (the notes' eq. 27, stretch = length − rest

@@ -175,6 +175,15 @@ def test_a_factor_zero_at_the_scenes_values_is_named_with_its_power(factor, type
             x,
             SPRING_Q_NC,
         ),
+        (  # −k x merged into (m w² − k) x, a coefficient holding it as a summand
+            "spring_mass_damper",
+            "x",
+            "-c x' + F0 cos(w t) + (m w^2 - k) x",
+            SPRING_Q_NC + (m * w**2 - k) * x,
+            SPRING_V,
+            x,
+            SPRING_Q_NC,
+        ),
         (
             "simple_pendulum",
             "theta",
