@@ -46,6 +46,7 @@ from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
 from mechanics.steps import Line, Step, tidy
 from mechanics.steps.conserved import explicit_time
+from mechanics.steps.forces import derived_letter
 
 SYMBOLIC_OPS_LIMIT = 200
 TOL = 1e-9
@@ -206,7 +207,8 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         if verdict.pole and not _held_at_pole(d, variant, q0, values):
             warnings.append(
-                f"Every $Q_j$ vanishes at {_point_text(m, q0)}, a pole of the coordinates, only "
+                f"Every ${derived_letter(m, 'Q')}_j$ vanishes at {_point_text(m, q0)}, a pole "
+                "of the coordinates, only "
                 "because they cannot move in every direction there: beside it the forces do not "
                 "shrink to 0 (a force or torque acts along a direction they lose there), so it is "
                 "not an equilibrium and is left out."
@@ -366,7 +368,8 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
     names = ", ".join(m.coordinate_names[j] for j in idle)
     if everything:
         return (
-            r"No force acts at rest at these parameters (every $Q_j$ vanishes at $\dot q = 0$): "
+            f"No force acts at rest at these parameters (every ${derived_letter(m, 'Q')}_j$ "
+            r"vanishes at $\dot q = 0$): "
             "every configuration is an equilibrium (a family), none held by a restoring force: the "
             "list shows one of them, and what a nudge does there."
         )
@@ -448,7 +451,10 @@ def _beyond_doubles(d: Derivation, parameters: dict, q0: list[float], exc: Excep
     m = d.model
     values = {f"parameters.{k}": float(v) for k, v in _checked(d, parameters).items()}
     at = ", ".join(f"{q} = {v:.4g}" for q, v in zip(m.coordinate_names, q0, strict=True))
-    what = "the linearization M δq̈ + C δq̇ + K δq = 0 overflows double precision"
+    # plain words: a 422 message is not typeset, and a bare M there read as a cart's mass
+    what = (
+        "the linearization (its mass, velocity and stiffness matrices) overflows double precision"
+    )
     if isinstance(exc, _ConditionsOverflow):
         what = "the conditions of equilibrium overflow double precision"
     elif isinstance(exc, np.linalg.LinAlgError):
@@ -521,11 +527,15 @@ def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
     key = tuple(conditions)
     if key not in known:
         known[key] = _virtual_work_lines(d, conditions)
+    Q, V = derived_letter(d.model, "Q"), derived_letter(d.model, "V")
+    # the forces step's own notation: Q_j is every applied force, Q_j^{NC} the part not in V
     text = (
         "Constraint forces do no virtual work, so only the applied forces enter: "
-        "δW = Σ_j Q_j δq_j with Q_j = Q_j^NC − ∂V/∂q_j evaluated at rest (q̇ = 0; where a "
-        "frame turns at a prescribed rate, the equations of motion at q̇ = q̈ = 0). The δq_j "
-        "are arbitrary, so each Q_j must vanish (notes II.A, eq. 18)."
+        rf"$\delta W = \sum_j {Q}_j\,\delta q_j$ with "
+        rf"${Q}_j = {Q}_j^{{NC}} - \partial {V}/\partial q_j$ evaluated at rest "
+        r"($\dot q = 0$; where a frame turns at a prescribed rate, the equations of motion at "
+        r"$\dot q = \ddot q = 0$). The $\delta q_j$ are arbitrary, so each "
+        f"${Q}_j$ must vanish (notes II.A, eq. 18)."
     )
     return Step("virtual_work", "Equilibrium by virtual work", text, list(known[key]))
 
@@ -552,10 +562,11 @@ def _virtual_work_lines(d: Derivation, conditions: list[sp.Expr]) -> list[Line]:
 
 def _condition_lines(d: Derivation, conditions: list[sp.Expr], where: str = "") -> list[Line]:
     m = d.model
+    Q = derived_letter(m, "Q")
     return [
         Line(
             f"Q_{name} at rest{where}",
-            rf"Q_{{{to_latex(q)}}}\big|_{{\dot q = 0}} = {to_latex(c)} = 0",
+            rf"{Q}_{{{to_latex(q)}}}\big|_{{\dot q = 0}} = {to_latex(c)} = 0",
             f"Q_{name} = {to_plain(c)} = 0{where}",
         )
         for name, q, c in zip(m.coordinate_names, m.q, conditions, strict=True)
@@ -726,10 +737,7 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
         else:
             roots.append(Root(point, {}, "numeric", "numeric search"))
     if symbolic is None:
-        notes.append(
-            "sympy could not solve the conditions in closed form: the equilibria "
-            "listed were found numerically."
-        )
+        notes.append(_numeric_note(eqs, bound, roots))
     elif len(roots) > len(symbolic):
         notes.append(
             "The numeric search found equilibria that sympy's closed-form solution missed; "
@@ -905,6 +913,46 @@ def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
     return out
 
 
+def _not_asked(eqs: tuple, n: int) -> str:
+    """Why sympy's solver is not called on these conditions ('' when it is): each limit keeps a
+    request bounded, and the note then says so instead of 'sympy could not'."""
+    if n > 2:
+        return "sympy is not asked to solve more than two conditions at once"
+    if sum(sp.count_ops(e) for e in eqs) > SYMBOLIC_OPS_LIMIT:
+        return "The conditions are too long to hand to sympy's solver"
+    if n == 2 and any(e.has(*_TRIG) for e in eqs):
+        return (
+            "sympy is not asked to solve two trigonometric conditions at once (it can take minutes)"
+        )
+    return ""
+
+
+def _numeric_note(eqs: list, bound: list[int], roots: list[Root]) -> str:
+    """What happened when sympy gave no closed form: not asked, or asked and failed; then the
+    search found the roots, and those it recognised (a simple value that satisfies the conditions
+    for any parameter values) carry a closed form. A note that said 'sympy could not' while
+    every entry showed one (the double pendulum's 0 and π) told the student two things."""
+    why = (
+        _not_asked(tuple(eqs), len(bound)) or "sympy could not solve the conditions in closed form"
+    )
+    recognised = sum(1 for r in roots if r.symbolic)
+    if not roots:
+        return f"{why}, and a numeric search found no equilibrium."
+    if recognised == len(roots):
+        found = (
+            "each was recognised in closed form (values that satisfy the conditions for any "
+            "parameter values)"
+        )
+    elif recognised:
+        found = (
+            f"{recognised} of the {len(roots)} were recognised in closed form; the others are "
+            "known as numbers only"
+        )
+    else:
+        found = "none was recognised in closed form: they are known as numbers only"
+    return f"{why}: the equilibria were found by a numeric search, and {found}."
+
+
 @functools.lru_cache(maxsize=512)
 def _solved(eqs: tuple, bound: tuple, psyms: tuple) -> list[_ClosedForm] | None:
     """sympy's closed-form solutions of the conditions, once per scene (they hold for every
@@ -912,10 +960,8 @@ def _solved(eqs: tuple, bound: tuple, psyms: tuple) -> list[_ClosedForm] | None:
     ``bound``: (index, q) of each coordinate solved for; the index names its symbol, which
     orders the variables of sympy's polynomial algebra (and so how long it takes)."""
     qs = tuple(q for _, q in bound)
-    if len(qs) > 2 or sum(sp.count_ops(e) for e in eqs) > SYMBOLIC_OPS_LIMIT:
-        return None
-    if len(qs) == 2 and any(e.has(*_TRIG) for e in eqs):
-        return None  # sp.solve can run for minutes on two trig equations; the search covers it
+    if _not_asked(eqs, len(qs)):
+        return None  # the numeric search covers it
     subs = {q: sp.Symbol(f"_q{j}", real=True) for j, q in bound}
     back = {v: k for k, v in subs.items()}
     try:
@@ -1190,8 +1236,19 @@ def _starts(system: _System) -> np.ndarray:
 
 #: The reasons carry their math as $…$ LaTeX, as the steps' prose does, so that the page typesets
 #: it and the LaTeX export keeps it math (plain 'e^(3.1 t)' read as a caret and a bracket).
-_POWER = r"\sum_j Q_j \dot q_j"
-_LINEARIZED = r"$M\,\delta\ddot q + C\,\delta\dot q + K\,\delta q = 0$"
+#: The matrices bold, as the matrix-form step writes its mass matrix (and a cart's mass M is not
+#: the mass matrix); f is that step's right-hand side.
+_LINEARIZED = r"$\mathbf M\,\delta\ddot q + \mathbf C\,\delta\dot q + \mathbf K\,\delta q = 0$"
+
+
+def _power_symbol(m: Any, at_rest: bool = True) -> str:
+    """The power of the velocity-dependent forces in the forces step's letters. Q_j there is
+    every applied force (Q_j^NC − ∂V/∂q_j), so the sum is over Q_j^NC, less its part at rest when
+    a force acts at rest too (a wind and its drag): that part is in K, not in this power."""
+    Q = derived_letter(m, "Q")
+    if at_rest:
+        return rf"\sum_j ({Q}_j^{{NC}} - {Q}_j^{{NC}}|_{{\dot q = 0}})\,\dot q_j"
+    return rf"\sum_j {Q}_j^{{NC}} \dot q_j"  # as the conserved step writes dE/dt
 
 
 @dataclass(frozen=True)
@@ -1206,18 +1263,21 @@ class Power:
 
     kind: str = "none"
     text: str = ""
+    #: The sum the text equates, as LaTeX (the general one when the scene's is not known).
+    symbol: str = r"\sum_j (Q_j^{NC} - Q_j^{NC}|_{\dot q = 0})\,\dot q_j"
 
 
-def _force_power(d: Derivation) -> tuple[sp.Expr, list[sp.Expr], bool]:
+def _force_power(d: Derivation) -> tuple[sp.Expr, list[sp.Expr], bool, bool]:
     """Once per scene: the velocity-dependent part of the forces' (and torques') power,
     Σ_j (Q_j − Q_j|q̇=0) q̇_j (the part at rest is conservative, in K, or circulatory, seen by
     K's asymmetry); each damper's coefficient c (its power is −c ℓ̇² ≤ 0 while c ≥ 0, a
-    dashpot); and whether any force depends on a velocity at all."""
+    dashpot); whether any force depends on a velocity at all; and whether any force that
+    does also acts at rest (then the power's symbol subtracts that part)."""
     m = d.model
     turning = _turning(m)  # then Σ Q q̇ ≠ F·v: dampers are judged like any force
     rest = dict.fromkeys(m.qd, sp.S.Zero)
     dampers = [] if turning else [parse(x.c, m.names, field="c") for x in m.spec.dampers]
-    power, moves = sp.S.Zero, False
+    power, moves, at_rest = sp.S.Zero, False, False
     for load in m.loads:
         if load.kind == "damper" and not turning:
             continue
@@ -1232,10 +1292,11 @@ def _force_power(d: Derivation) -> tuple[sp.Expr, list[sp.Expr], bool]:
             if moving != 0:
                 moves = True
                 power += moving * qd
+                at_rest = at_rest or Q != moving
     power = sp.expand(power)
     if power != 0 and sp.count_ops(power) <= 400:
         power = tidy(power, m)
-    return power, dampers, moves
+    return power, dampers, moves, at_rest
 
 
 def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
@@ -1245,23 +1306,28 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
     m = d.model
     if not m.loads:
         return Power()
-    power, dampers, moves = _once(d, "power", "", lambda: _force_power(d))
+    power, dampers, moves, at_rest = _once(d, "power", "", lambda: _force_power(d))
+    symbol = _power_symbol(m, at_rest)
     try:
         leaky = any(float(c.xreplace(values)) < 0 for c in dampers)
     except (TypeError, ValueError):
         leaky = True
-    if leaky:
-        return Power("no sign", rf"${_POWER} = -c\,\dot\ell^2$ of a damper with $c < 0$")
+    if leaky:  # a damper's own share of the sum, which alone can feed energy in
+        return Power(
+            "no sign", r"$-c\,\dot\ell^2$ of a damper with $c < 0$", _power_symbol(m, False)
+        )
     if not moves:
-        return Power("dissipative" if dampers else "none")
+        return Power("dissipative" if dampers else "none", symbol=symbol)
     at = sp.expand(power.xreplace(values)) if power != 0 else power
     if at == 0:  # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0
-        return Power("dissipative" if dampers else "no work")
+        return Power("dissipative" if dampers else "no work", symbol=symbol)
     proven = _once(d, "never positive", at, lambda: _never_positive(m, at))
-    text = f"${_POWER} = {_once(d, 'power latex', '', lambda: to_latex(power))}$"
+    text = f"${symbol} = {_once(d, 'power latex', '', lambda: to_latex(power))}$"
+    if dampers:  # their share, −c ℓ̇² ≤ 0, is judged apart and not in the sum shown
+        text += " (dampers aside)"
     if proven or _quadratic_wins(m, at, q0):
-        return Power("dissipative", text)
-    return Power("no sign", text)
+        return Power("dissipative", text, symbol)
+    return Power("no sign", text, symbol)
 
 
 def _never_positive(m: Any, power: sp.Expr) -> bool:
@@ -1507,10 +1573,11 @@ def _at_a_pole(verdict, m, full_M, at_rest, q0, numbers, idx, lost, free) -> Non
     where = "$" + ", ".join(f"{to_latex(m.q[j])} = {_num(q0[j])}" for j in idx) + "$"
     inertia = float(np.max(np.abs(full_M), initial=0.0))
     if all(np.max(np.abs(full_M[j])) <= 1e-12 * inertia for j in lost):
-        why = f"any {lost_names} names the same point: its row of $M$ vanishes"
+        why = f"any {lost_names} names the same point: its row of $\\mathbf M$ vanishes"
     else:  # Euler angles at θ = 0: φ and ψ turn about one axis
         why = (
-            f"$M$ is singular here for every parameter value, not for these numbers only: a turn "
+            "$\\mathbf M$ is singular here for every parameter value, not for these numbers only: "
+            "a turn "
             f"of {lost_names} is one the other coordinates make too, so any {lost_names} names "
             "the same configuration up to them"
         )
@@ -1632,7 +1699,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             reason += "; " + _circulatory(grow, tol)
         elif np.min(k_eigs) < -k_tol and not gyroscopic:
             reason += (
-                f"; $K$ has a negative eigenvalue: the {_potential(turning)} has no minimum here"
+                f"; $\\mathbf K$ has a negative eigenvalue: the {_potential(turning)} has no "
+                "minimum here"
             )
         return "unstable", reason, lam, vecs
     zero = np.abs(lam) <= 1e-6 * scale
@@ -1642,7 +1710,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             nudge = (
                 f"the {_gyroscopic(turning, power)} terms turn a nudge in velocity into a bounded "
                 "loop, "
-                "not a drift, but $K$ is singular in every direction and nonlinear terms decide "
+                "not a drift, but $\\mathbf K$ is singular in every direction and nonlinear terms "
+                "decide "
                 "(neutral at best)"
             )
         elif damped:
@@ -1657,7 +1726,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             )
         return (
             "marginal",
-            "every coordinate is free: no force acts at rest in any direction ($K$ vanishes), so "
+            "every coordinate is free: no force acts at rest in any direction ($\\mathbf K$ "
+            "vanishes), so "
             f"every nearby configuration is an equilibrium too, and {nudge}; eigenvalues {shown}",
             lam,
             vecs,
@@ -1684,7 +1754,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     if k_null > n_free:
         return (
             "marginal",
-            "$K$ is singular in a direction that is not a free coordinate (eigenvalues "
+            "$\\mathbf K$ is singular in a direction that is not a free coordinate (eigenvalues "
             f"{shown}): the quadratic approximation is flat there, so the linear test cannot "
             "decide; higher-order terms do (a bifurcation point, or a family of equilibria)",
             lam,
@@ -1708,7 +1778,8 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     if k_pd_off_free and c_psd and power.kind == "no sign":
         return (
             "marginal",
-            f"$K$ is positive definite (the {_potential(turning)} has a minimum here) and no "
+            f"$\\mathbf K$ is positive definite (the {_potential(turning)} has a minimum here) and "
+            "no "
             f"eigenvalue has positive real part ({shown}), but the velocity-dependent forces' "
             f"power {power.text} has no sign: they can feed energy in, which the "
             "linearization does not see, so the minimum need not hold the motion "
@@ -1718,21 +1789,23 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             vecs,
         )
     if k_pd_off_free and c_psd:
-        reason = f"$K$ is positive definite, so the {_potential(turning)} has a minimum here"
+        reason = (
+            f"$\\mathbf K$ is positive definite, so the {_potential(turning)} has a minimum here"
+        )
         if n_free:  # K is singular along the free directions: definite only off them
             reason = (
-                f"$K$ is positive definite off the {n_free} free direction(s), so the "
+                f"$\\mathbf K$ is positive definite off the {n_free} free direction(s), so the "
                 f"{_potential(turning)} has a minimum across them"
             )
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
             reason = (
-                f"$K$ is positive definite, so the {_potential(turning)} has a minimum; "
+                f"$\\mathbf K$ is positive definite, so the {_potential(turning)} has a minimum; "
                 "velocity-linear terms cannot undo that (Thomson–Tait)"
             )
         if power.kind == "no work":
             reason += (
-                f"; the velocity-dependent forces do no work (their power ${_POWER} = 0$), so "
-                "the energy cannot grow"
+                "; the velocity-dependent forces do no work (their power "
+                f"${power.symbol} = 0$), so the energy cannot grow"
             )
         elif power.kind == "dissipative" and power.text:
             reason += (
@@ -1754,8 +1827,10 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
     ):
         return (
             "gyroscopically stable",
-            f"$K$ is not positive definite (its eigenvalues ${', '.join(_num(k) for k in k_shown)}"
-            f"$), but the {_gyroscopic(turning, power)} terms (in $C$) keep every eigenvalue on "
+            "$\\mathbf K$ is not positive definite (its eigenvalues "
+            f"${', '.join(_num(k) for k in k_shown)}"
+            f"$), but the {_gyroscopic(turning, power)} terms (in $\\mathbf C$) keep every "
+            "eigenvalue on "
             "the imaginary "
             f"axis without repeated defective ones ({shown}): the linearized motion stays "
             "bounded. Any damping would destroy this (Kelvin–Tait–Chetaev), and nonlinear terms "
@@ -1771,7 +1846,10 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
             "can feed energy in)"
         )
     else:
-        why = "$K$ is not positive definite and no gyroscopic term accounts for the stability"
+        why = (
+            "$\\mathbf K$ is not positive definite and no gyroscopic term accounts for the "
+            "stability"
+        )
     return (
         "marginal",
         f"no eigenvalue has positive real part ({shown}), but {why}: the linear test cannot "
@@ -1782,8 +1860,10 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
 
 
 _CIRCULATORY = (
-    "$K$ is not symmetric: position-dependent non-conservative (circulatory) forces act, a "
-    "follower load say, so no potential stands behind $K$ and its eigenvalues say nothing of a "
+    "$\\mathbf K$ is not symmetric: position-dependent non-conservative (circulatory) forces act, "
+    "a "
+    "follower load say, so no potential stands behind $\\mathbf K$ and its eigenvalues say nothing "
+    "of a "
     "minimum; only the eigenvalues of the full linearization decide"
 )
 
@@ -2005,7 +2085,7 @@ def reason_plain(reason: str) -> str:
     text = re.sub(  # every macro but the accents, which then sit on a letter
         r"\\(?!d?dot(?![A-Za-z]))([A-Za-z]+|.)",
         lambda m: _plain_macro(m.group(1)),
-        reason.replace("$", ""),
+        re.sub(r"\\mathbf\s*", "", reason.replace("$", "")),  # bold K is K in plain text
     )
     text = re.sub(
         r"\\(d?dot)\s*\{?([^\s{}\\])\}?",
@@ -2018,15 +2098,19 @@ def reason_plain(reason: str) -> str:
 def _stability_step(m: Any, results: list[dict], verdicts: list[Verdict]) -> Step:
     text = (
         rf"About each equilibrium $q_0$ the motion linearizes to {_LINEARIZED} with "
-        r"$K = -\partial f/\partial q$ and $C = -\partial f/\partial \dot q$ at rest ($C$ "
+        r"$\mathbf K = -\partial \mathbf f/\partial q$ and "
+        r"$\mathbf C = -\partial \mathbf f/\partial \dot q$ at rest ($\mathbf f$ of the matrix "
+        r"form $\mathbf M\,\ddot q = \mathbf f$; $\mathbf C$ "
         "holds damping and the gyroscopic terms: Coriolis where a frame turns, forces that do "
         r"no work such as a magnetic one). With $\delta q \propto e^{\lambda t}$ the eigenvalues "
         r"$\lambda$ of the first-order system decide: any $\operatorname{Re}\lambda > 0$ is "
-        r"unstable; all $\operatorname{Re}\lambda < 0$ is asymptotically stable; $K$ symmetric "
+        r"unstable; all $\operatorname{Re}\lambda < 0$ is asymptotically stable; $\mathbf K$ "
+        r"symmetric "
         "and positive definite is stable by the potential (Lagrange–Dirichlet) when the "
-        f"velocity-dependent forces do no positive work (their power ${_POWER}$ is 0 or "
-        r"$\le 0$), and undecided when it has no sign; a $K$ that is not symmetric "
-        "(circulatory forces) has no potential behind it, so only the eigenvalues speak; $K$ "
+        f"velocity-dependent forces do no positive work (their power ${_power_symbol(m)}$ is 0 or "
+        r"$\le 0$), and undecided when it has no sign; a $\mathbf K$ that is not symmetric "
+        "(circulatory forces) has no potential behind it, so only the eigenvalues speak; "
+        r"$\mathbf K$ "
         "not positive definite with every $\\lambda$ simple on the imaginary axis is "
         "gyroscopically stable (only linearly: damping destroys it); what the linear test "
         "cannot decide is marginal. The small-oscillation frequencies are the imaginary parts "

@@ -124,10 +124,11 @@ def test_the_stability_step_writes_names_and_powers_as_latex():
 
 
 def test_a_power_is_written_as_latex_not_python():
-    """The cubic force's power F ẋ = c ẋ⁴ (by hand) appears as c \\dot{x}^{4}, not c*x_dot**4."""
+    """The cubic force's power F ẋ = c ẋ⁴ (by hand) appears as c \\dot{x}^{4}, not c*x_dot**4;
+    it is the non-conservative forces' power (Q_j^NC, the forces step's letter), not Q_j's."""
     (e,) = POSTED["cubic pumping"]["equilibria"]
-    assert r"$\sum_j Q_j \dot q_j = c \dot{x}^{4}$" in e["reason"]
-    assert "Σ_j Q_j q̇_j = c ẋ^4" in reason_plain(e["reason"])
+    assert r"$\sum_j Q_j^{NC} \dot q_j = c \dot{x}^{4}$" in e["reason"]
+    assert "Σ_j Q_j^NC q̇_j = c ẋ^4" in reason_plain(e["reason"])
 
 
 # --- one meaning per symbol: a parameter named E or Q ------------------------------------------

@@ -20,21 +20,23 @@ const KIND_CLASS = {
  * slate #3b4a63 on #e8edf5 is 7.6:1 (AA needs 4.5:1 for its small type). */
 const NEUTRAL = { color: "#3b4a63", background: "#e8edf5" };
 
-/** The first time the panel says $K$ (or $C$), what it is: the reasons speak of them as known.
+/** The first time the panel says $\mathbf K$ (or $\mathbf C$), what it is: the reasons speak
+ * of them as known, bold as the derivation's matrix step writes its matrices (a cart's mass M
+ * is not the mass matrix).
  * The gloss follows the reason: K is the Hessian of V only where a potential stands behind it
  * (not under a follower load, and of the effective potential where a frame turns); C's
  * symmetric part is damping and its antisymmetric part gyroscopic, whatever their source (the
  * reason names it: Coriolis only where a frame turns, else forces that do no work). */
 const GLOSSES = [
-  ["$K$", (text) => (/not symmetric/.test(text)
-    ? "the stiffness matrix $K$ (the restoring force per unit displacement, not the Hessian of any potential)"
+  ["$\\mathbf K$", (text) => (/not symmetric/.test(text)
+    ? "the stiffness matrix $\\mathbf K$ (the restoring force per unit displacement, not the Hessian of any potential)"
     : /effective potential/.test(text)
-      ? "the stiffness matrix $K$ (the Hessian of the effective potential)"
-      : "the stiffness matrix $K = \\partial^2 V/\\partial q^2$")],
-  ["$C$", () => "$C$ (the velocity matrix: its symmetric part damping, its antisymmetric part gyroscopic)"],
+      ? "the stiffness matrix $\\mathbf K$ (the Hessian of the effective potential)"
+      : "the stiffness matrix $\\mathbf K = \\partial^2 V/\\partial q^2$")],
+  ["$\\mathbf C$", () => "$\\mathbf C$ (the velocity matrix: its symmetric part damping, its antisymmetric part gyroscopic)"],
 ];
 
-/** `text` with the first unglossed $K$ or $C$ explained in place; `said` keeps what was. */
+/** `text` with the first unglossed bold K or C explained in place; `said` keeps what was. */
 function glossed(text, said) {
   for (const [symbol, gloss] of GLOSSES) {
     if (said.has(symbol) || !text.includes(symbol)) continue;
