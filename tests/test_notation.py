@@ -248,7 +248,7 @@ const kinds = drawFBD(svg, d.spec, d.result, d.spec.parameters, d.i, {}, d.place
 const box = { dataset: {}, children: [], replaceChildren(...c) { this.children = c; } };
 fbdLegend(box, kinds);
 console.log(JSON.stringify({ svg: svg.innerHTML, min: MIN_ARROW,
-  legend: box.children.map((c) => c.textContent) }));
+  legend: box.children.map((c) => c.innerHTML ?? c.textContent) }));
 """
 
 
@@ -304,13 +304,13 @@ def test_atwood_arrows_are_in_the_ratio_of_the_forces():
         text.startswith("arrows to scale") and "except" not in text for text in drawn["legend"]
     )
     assert not any(text.startswith("T ") or " T tension" in text for text in drawn["legend"])
-    assert any("F_T tension" in text for text in drawn["legend"])
+    assert any("<i>F</i><sub>T</sub> tension" in text for text in drawn["legend"])
 
 
 @needs_node
 def test_rolling_disk_friction_is_short_and_the_legend_says_so():
-    """m g = 9.81 N, N = m g cos α = 8.61 N, f_s = m g sin α / 3 = 1.57 N (by hand): N to scale
-    against the weight; f_s would be shorter than the minimum, is drawn at it and named."""
+    """m g = 9.81 N, F_N = m g cos α = 8.61 N, F_f = m g sin α / 3 = 1.57 N (by hand): F_N to
+    scale against the weight; F_f would be shorter than the minimum, is drawn at it and named."""
     m, g, alpha = 1.0, 9.81, 0.5
     drawn = draw("rolling_disk")
     (weight,) = [length for c, length in arrows(drawn["svg"]) if c == WEIGHT]
@@ -322,4 +322,4 @@ def test_rolling_disk_friction_is_short_and_the_legend_says_so():
     assert f_s / (m * g) * weight < drawn["min"]  # too small to draw to scale ...
     assert friction == pytest.approx(drawn["min"], abs=0.2)  # ... so drawn at the minimum
     (scale,) = [text for text in drawn["legend"] if text.startswith("arrows to scale")]
-    assert "f_s,disk" in scale and "minimum length" in scale
+    assert "<i>F</i><sub>f,disk</sub>" in scale and "minimum length" in scale

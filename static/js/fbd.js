@@ -1,10 +1,11 @@
 // The free-body diagram at the current instant: the scene drawn faintly, and on every body each
 // force of the run (`forces` of /simulate: weight F_g, spring, damper, applied) as a labelled
 // arrow, plus the constraint forces (dashed), named and placed as the derivation's FBD step says
-// (`constraint_forces` of its data: a rod's tension F_T, a normal force N, static friction f_s at
-// a rolling contact, a pin reaction R at the pin), sized by Newton's R = m a − ΣF of the run.
+// (`constraint_forces` of its data: a rod's tension F_T, a normal force F_N, static friction F_f at
+// a rolling contact, a pin reaction F_pin at the pin), sized by Newton's F_C = m a − ΣF of the run.
 // Arrows are to scale: one px-per-newton for the whole diagram (`arrowLengths`), the largest force
 // MAX_ARROW px long; only a force too small to see is drawn at MIN_ARROW px, and the legend says so.
+// The legend is decided once per run (`runLegend`): it must not change height while the run plays.
 import { SceneGeometry } from "./geometry.js";
 import { toSVG } from "./render.js";
 import { placeLabel, sceneShapes } from "./shapes.js";
@@ -74,9 +75,9 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   const view = new View(W, H, geom.is3D);
   if (geom.is3D) Object.assign(view, { yaw: angles.yaw ?? view.yaw, pitch: angles.pitch ?? view.pitch });
   view.fit(geom.extent([i]), 78);
+  const px = labelSize(svg);
   const shapes = sceneShapes(geom, view, i, { radius: 8, muted: true, labels: false, axes: false });
-  const arrows = forcesAt(result, i, placed, parameters);
-  arrows.push(...potentialForces(spec, result, parameters, i, arrows));
+  const arrows = arrowsAt(spec, result, parameters, i, placed);
   const kinds = new Set();
   const biggest = Math.max(...arrows.map((a) => a.size), 1e-12);
   const scale = arrowLengths(arrows.map((a) => a.size));
@@ -127,14 +128,17 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   // labels after every arrow is down, each just beyond its arrow's tip where that is free
   for (const { tip, d, text, sub, color } of labels) {
     const before = shapes.length;
-    const width = 1.06 * (textWidth(text, 13) + textWidth(sub, 13 * 0.75)) + 3;
-    placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, 13, { width, toward: d, below: sub ? 7 : 4 });
+    const width = 1.06 * (textWidth(text, px) + textWidth(sub, px * 0.75)) + 3;
+    const below = (sub ? 7 : 4) * (px / 13);
+    placeLabel(shapes, occupied, tip, 3, text + sub, color, W, H, px, { width, toward: d, below });
     const label = shapes[before];
     Object.assign(label, { text, sub, italic: true, weight: 600 });
   }
   for (const b of geom.bodies) {
     const [x, y] = view.project(geom.at(b.name, i));
-    placeLabel(shapes, occupied, [x, y], 10, b.name, "#495057", W, H, 11);
+    const size = px === 13 ? 11 : px; // in lecture mode as large as the forces' names
+    const width = 1.06 * textWidth(b.name, size) + 3;
+    placeLabel(shapes, occupied, [x, y], 10, b.name, "#495057", W, H, size, { width, below: 0.3 * size });
   }
   shapes.push({ t: "text", at: [8, H - 8], text: `t = ${result.t[i].toFixed(2)} s`, color: "#6c757d", size: 11 });
   svg.innerHTML = toSVG(shapes);
@@ -144,9 +148,62 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   const named = arrows.filter((a) => a.kind === "constraint" && a.size >= 1e-9 * biggest);
   svg.dataset.constraints = JSON.stringify(named.map(({ name, on, at, x, y, z, what }) =>
     ({ name, on, what, at: at || geom.at(on, i), centre: geom.at(on, i), force: [x, y, z] })));
-  kinds.constraints = [...new Set(named.map((a) => a.name))];
-  kinds.short = short;
-  return kinds;
+  // the legend's content is the run's, not this instant's (`runLegend`)
+  const run = runLegend(spec, result, parameters, placed);
+  const legend = new Set(run.kinds);
+  legend.constraints = run.constraints;
+  legend.short = run.short;
+  legend.now = { kinds: [...kinds], short };
+  return legend;
+}
+
+/** The lecture hall's least label size (CSS px on screen): lecture mode enlarges a drawing's labels
+ * to it after the drawing is done, so they are placed at that size here, where overlaps are avoided. */
+const LECTURE_LABEL_PX = 24;
+
+/** Font size (svg units) of a force's label: 13, or in lecture mode as large as the hall needs. */
+function labelSize(svg) {
+  const lecture = typeof document !== "undefined" && document.body?.classList?.contains("lecture");
+  const shown = lecture && svg.getBoundingClientRect ? svg.getBoundingClientRect().width : 0;
+  if (!shown) return 13;
+  return Math.max(13, Math.ceil((LECTURE_LABEL_PX * W * 100) / shown) / 100);
+}
+
+/** Every force of sample i as the diagram draws it (constraint forces, potentials' forces too). */
+function arrowsAt(spec, result, parameters, i, placed) {
+  const arrows = forcesAt(result, i, placed, parameters);
+  arrows.push(...potentialForces(spec, result, parameters, i, arrows));
+  return arrows;
+}
+
+const legends = new WeakMap(); // result -> {placed, parameters, legend}
+
+/** What the legend says for a whole run: the kinds of force drawn at any instant, the constraint
+ * forces named, and the forces too small to draw to scale at some instant (over every sample).
+ * Decided per instant it came and went as the run played, and the page jumped in height. */
+export function runLegend(spec, result, parameters, placed) {
+  const known = legends.get(result);
+  if (known && known.placed === placed && known.parameters === parameters && known.spec === spec) {
+    return known.legend;
+  }
+  const kinds = new Set(), constraints = new Set(), short = new Map();
+  const n = result.t?.length || 0;
+  for (let i = 0; i < n; i++) {
+    const arrows = arrowsAt(spec, result, parameters, i, placed).filter((a) => result.positions[a.on]);
+    const biggest = Math.max(...arrows.map((a) => a.size), 1e-12);
+    const scale = arrowLengths(arrows.map((a) => a.size));
+    arrows.forEach((f, k) => {
+      if (f.size < 1e-9 * biggest) return;
+      kinds.add(f.kind);
+      if (f.kind === "constraint") constraints.add(f.name);
+      if (f.kind === "torque" || !scale.arrows[k].short) return;
+      const { text, sub } = f.symbol ? { text: f.symbol[0], sub: f.symbol[1] } : labelParts(f.label);
+      short.set(sub ? `${text}_${sub}` : text, [text, sub]);
+    });
+  }
+  const legend = { kinds: [...kinds], constraints: [...constraints], short: [...short.values()] };
+  legends.set(result, { placed, parameters, spec, legend });
+  return legend;
 }
 
 function forcesAt(result, i, placed, parameters) {
@@ -160,14 +217,14 @@ function forcesAt(result, i, placed, parameters) {
 /** The constraint forces at sample i, each where it acts. Newton's R = m a − ΣF of a body is
  * the sum of its constraint forces; the FBD step says how it splits: the pulls of the rods that
  * hang from the body, then the rest (a rod's tension toward its anchor, a normal force, at a
- * rolling contact N across the surface and f_s along it). Without that data (an old derivation)
- * R is drawn whole at the body, named only as a resultant. */
+ * rolling contact F_N across the surface and F_f along it). Without that data (an old derivation)
+ * the whole F_C is drawn at the body, named only as a resultant. */
 export function constraintForcesAt(result, i, placed, parameters = {}) {
   const R = result.constraint_forces || {};
   const total = (on) => (R[on] ? [R[on].x[i], R[on].y[i], R[on].z[i]] : null);
   const entries = (placed?.bodies || []).flatMap((b) => b.constraint_forces || []);
   if (!placed?.bodies?.some((b) => b.constraint_forces)) {
-    return Object.keys(R).map((on) => arrow({ name: "R", symbol: ["R", on], on,
+    return Object.keys(R).map((on) => arrow({ name: "F_C", symbol: ["F", `C,${on}`], on,
       what: `resultant of the constraint forces on ${on}` }, total(on)));
   }
   const vars = { ...parameters, t: result.t[i] };
@@ -316,28 +373,46 @@ function torqueArc([x, y], sign, color) {
     { t: "arrow", a: prev, b: end, color, width: 2.2, head: 8 }];
 }
 
-// F_T, not T: T is the kinetic energy of the derivation's energy step
-const CONSTRAINT_NAMES = { F_T: "F_T tension of a rod or rope", N: "N normal force", f_s: "f_s static friction",
-  R: "R pin reaction or resultant" };
+const escapeHTML = (x) => String(x).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
 
-/** The legend under the diagram: one swatch per kind of force drawn. */
+/** A symbol as the steps' math sets it: italic letter, upright subscript (`F_T,bob1` → F with
+ * subscript T,bob1). The legend is redrawn outside MathJax's reach (it follows the run), so it is
+ * HTML, never raw underscores. */
+export function symbolHTML(text, sub = "") {
+  return `<i>${escapeHTML(text)}</i>${sub ? `<sub>${escapeHTML(sub)}</sub>` : ""}`;
+}
+
+// one family, F with a subscript: T is the kinetic energy, N the inertial frame, R a radius
+const CONSTRAINT_NAMES = {
+  F_T: `${symbolHTML("F", "T")} tension of a rod or rope`, F_N: `${symbolHTML("F", "N")} normal force`,
+  F_f: `${symbolHTML("F", "f")} static friction`, F_pin: `${symbolHTML("F", "pin")} pin reaction`,
+  F_C: `${symbolHTML("F", "C")} resultant of a body's constraint forces`,
+};
+
+/** The legend under the diagram: one swatch per kind of force the run draws, the same at every
+ * instant (`runLegend`), its symbols set as math. */
 export function fbdLegend(box, kinds) {
-  const named = (kinds.constraints || []).map((n) => CONSTRAINT_NAMES[n] || n).join(", ");
-  const names = { weight: "weight F_g = mg", spring: "spring", damper: "damper", force: "applied force", torque: "applied torque",
-    constraint: `constraint force, dashed${named ? ` (${named})` : ""}`, potential: "force of a potential V" };
+  const named = (kinds.constraints || []).map((n) => CONSTRAINT_NAMES[n] || escapeHTML(n)).join(", ");
+  const names = {
+    weight: `weight ${symbolHTML("F", "g")} = <i>m</i><i>g</i>`, spring: "spring", damper: "damper",
+    force: "applied force", torque: "applied torque",
+    constraint: `constraint force, dashed${named ? ` (${named})` : ""}`,
+    potential: `force of a potential ${symbolHTML("V")}`,
+  };
   const short = kinds.short || [];
-  const key = [...kinds].sort().join() + named + short.join();
+  const key = [...kinds].sort().join() + named + short.map(([t, s]) => `${t}_${s}`).join();
   if (box.dataset.kinds === key) return;
   box.dataset.kinds = key;
   const scale = document.createElement("span");
   scale.className = "fbd-scale";
-  scale.textContent = "arrows to scale" + (short.length
-    ? ` (except ${short.join(", ")}: too small to draw, shown at the minimum length)` : "");
+  const which = short.map(([t, s]) => symbolHTML(t, s)).join(", ");
+  scale.innerHTML = "arrows to scale" + (short.length
+    ? ` (except ${which} when too small to draw: then shown at the minimum length)` : "");
   box.replaceChildren(...Object.keys(names).filter((k) => kinds.has(k)).map((k) => {
     const span = document.createElement("span");
     span.className = `swatch ${k}`;
     span.style.setProperty("--c", FORCE_COLORS[k]);
-    span.textContent = names[k];
+    span.innerHTML = names[k];
     return span;
   }), scale);
 }
