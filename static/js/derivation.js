@@ -21,20 +21,30 @@ function renderStep(step, k, target, coordinates) {
   li.append(el("h3", {}, el("span", { className: "num", textContent: `${k + 1}` }), step.title));
   const body = el("div", { className: "step-body" });
   const words = el("div", { className: "step-words" });
-  words.append(el("p", { className: "text", textContent: inlineMath(step.text) }));
+  words.append(el("p", { className: "text" }, ...prose(step.text)));
   if (step.id === "fbd") {
     const figure = el("figure", { className: "fbd" });
     figure.innerHTML = `<svg id="fbd-svg" role="img" aria-label="free-body diagram"></svg>
       <figcaption><span id="fbd-legend" class="legend"></span>
       <span class="muted">Drawn at the animation's current instant: pause or scrub to study one.</span></figcaption>`;
     body.append(figure);
-    for (const note of step.data?.constraints || []) words.append(el("p", { className: "note", textContent: inlineMath(note) }));
+    for (const note of step.data?.constraints || []) words.append(el("p", { className: "note" }, ...prose(note)));
   }
   step.latex.forEach((tex, j) => words.append(mathLine(tex, step.plain[j] ?? "", step.labels?.[j] ?? "", coordinates)));
   body.prepend(words);
   li.append(body);
   for (const box of yourTurn(step.id, target, coordinates)) li.append(box);
   return li;
+}
+
+/**
+ * A sentence with `$…$` math as text and nodes for MathJax, each math with the punctuation right
+ * after it in a span that does not wrap: the line broke between "$\\mathbf f(q,\\dot q,t)$" and
+ * its "." (a full stop alone at the start of a line, at 1024×768 in lecture mode).
+ */
+export function prose(text) {
+  return String(text).split(/(\$[^$]+\$[.,;:!?)]*)/).filter(Boolean).map((part) =>
+    part.startsWith("$") ? el("span", { className: "math-nowrap", textContent: inlineMath(part) }) : part);
 }
 
 /** One display equation with its tools; the engine's label (what provenance.js and page.js look
@@ -103,6 +113,8 @@ function yourTurn(stepId, target, coordinates) {
     const input = box.querySelector("input");
     const result = box.querySelector(".result");
     const verdict = box.querySelector(".verdict");
+    // the box narrows (a phone turned, lecture mode's column): which math scrolls is asked again
+    new ResizeObserver(() => markWide(result)).observe(result);
     let asked = 0; // only the latest check may fill the box: a slow earlier answer never lands on it
     const ask = async (reveal) => {
       // an empty box is no answer: never sent as "0" (which is Q^NC of every conservative scene,
@@ -135,6 +147,7 @@ function yourTurn(stepId, target, coordinates) {
           box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
           offerPrediction(box.querySelector(".predict"), null);
           await typeset([result]);
+          markWide(result);
           result.dataset.checked = String(mine);
           return;
         }
@@ -150,6 +163,7 @@ function yourTurn(stepId, target, coordinates) {
         box.querySelector(".expected").textContent = r.expected_latex ? `\\[${r.expected_latex}\\]` : "";
         offerPrediction(box.querySelector(".predict"), r.correct ? null : body);
         await typeset([result]);
+        markWide(result);
         result.dataset.checked = String(mine); // settled and typeset (tests wait on it)
       } catch (err) {
         if (mine !== asked) return;
@@ -170,6 +184,20 @@ function yourTurn(stepId, target, coordinates) {
     });
     return box;
   });
+}
+
+/** The math of a result wider than its box scrolls inside it (app.css: a 390 px phone's "read as"
+ * of a double pendulum's T ran to 509 px and the whole page scrolled sideways); `scrolls` marks
+ * which, for the fade and the "scroll →" under it. */
+function markWide(result) {
+  for (const math of result.querySelectorAll("mjx-container")) {
+    math.classList.remove("scrolls"); // measured at its own width (inline math has no scrollWidth)
+    const box = math.closest(".echo, li, .expected") || result;
+    const style = getComputedStyle(box);
+    const right = box.getBoundingClientRect().right - parseFloat(style.paddingRight) - parseFloat(style.borderRightWidth);
+    const wide = math.scrollWidth > math.clientWidth + 1 || math.getBoundingClientRect().right > right + 1;
+    math.classList.toggle("scrolls", wide);
+  }
 }
 
 /**

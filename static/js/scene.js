@@ -518,6 +518,9 @@ class SceneView {
       this.lecture.open(this.wantedSteps);
       this.wantedSteps = null;
     } else this.lecture.apply();
+    // the address says the step shown: a link's step=99 past the last one is clamped to it (as a
+    // step=-3 or step=abc is read as the first), so a copied address opens where the room is
+    this.#saveURL();
     if (this.result) this.fbd(true);
     // One step at a time with a frame between: typesetting the whole derivation at once holds the
     // main thread for half a second, during which the animation could not start or move.
