@@ -84,6 +84,8 @@ export function sceneShapes(geom, view, i, opts = {}) {
     out.push({ t: "text", at: [x + 9, y - 8], text: name, color: "#6c5200", size: o.font, halo: true });
   }
   for (const b of geom.bodies) body(geom, view, b, i, tint(b.name), rad(b.name), sliding.get(b.name), o, out, occupied);
+  // the scale bar's corner before the names: they keep clear of it, as it keeps clear of the bodies
+  const bar = o.scaleBar && !geom.is3D ? scaleBar(geom, view, i, o, occupied, rad, sliding) : [];
   if (o.labels) {
     const w = view.w, h = view.h;
     for (const b of geom.bodies) {
@@ -107,7 +109,7 @@ export function sceneShapes(geom, view, i, opts = {}) {
       occupied.push(box);
     }
   }
-  if (o.scaleBar && !geom.is3D) scaleBar(view, out, o.font - 1, occupied);
+  out.push(...bar);
   return out;
 }
 
@@ -419,21 +421,94 @@ export function placeLabel(out, occupied, [x, y], r, text, color, w, h, size = 1
   out.push({ t: "text", at: [pick[0], pick[3] - below], text, color, size, halo: true });
 }
 
-/** A bar of a round length in a corner: the bottom-left one, or the first corner where neither
- * the bar nor its label covers a body or a name (at lecture size the label is 25 px). */
-function scaleBar(view, out, size, occupied = []) {
-  const target = 110 / view.scale;
-  const p = 10 ** Math.floor(Math.log10(target));
-  const nice = [1, 2, 5, 10].map((k) => k * p).filter((v) => v <= target).pop() || p;
+/** Where the scale bar goes, per run and view: geom -> Map(view -> [length index, corner index]). */
+const BAR_PLACES = new WeakMap();
+
+/** The bar's lengths on the screen, longest first: a shorter one where the long one would cover a
+ * body (a chaotic double pendulum's bob reaches every corner of a lecture canvas). */
+const BAR_PX = [110, 60, 35];
+
+/**
+ * A bar of a round length in a corner: the bottom-left one, or the first corner (then the middle
+ * of the left or right edge) where neither the bar nor its label covers a body (at lecture size
+ * the label is 25 px) at any instant of the run, chosen once per run and view so it never jumps;
+ * a shorter bar where no place is free for a long one; where none is free for the whole run, a
+ * place clear of the bodies at each frame. Chosen per frame, the corner free at the first frame was covered later (the Atwood
+ * machine's lower block sat on "1 m" at t = 0.89 s on a lecture canvas). A camera that follows
+ * the motion moves every body on the screen from frame to frame: there the corner is chosen per
+ * frame, clear of what is drawn now. Returns the shapes.
+ */
+function scaleBar(geom, view, i, o, occupied, rad, sliding) {
+  const size = o.font - 1;
+  const layouts = BAR_PX.map((target) => barLayout(view, size, target));
+  // a camera that follows the motion looks at the bodies' middle at every frame (draw.js)
+  const following = String(view.center) === String(geom.focus(i));
+  const overlaps = (b, c) => b[0] < c[2] && b[2] > c[0] && b[1] < c[3] && b[3] > c[1];
+  const nowFree = () => { // clear of what is drawn at this frame: the longest bar that has a place
+    for (const [n, { boxes }] of layouts.entries()) {
+      const k = boxes.slice(0, following ? -1 : undefined).findIndex((b) => !occupied.some((c) => overlaps(b, c)));
+      if (k >= 0) return [n, k];
+    }
+    return [0, 0];
+  };
+  const [n, k] = (following ? null : runPlace(geom, view, o, layouts.map((l) => l.boxes), rad, sliding)) || nowFree();
+  const { px, label, boxes } = layouts[n];
+  const box = boxes[k];
+  occupied.push(box);
+  const x = box[0], y = box[3] - 4;
+  return [
+    { t: "poly", pts: [[x, y - 5], [x, y], [x + px, y], [x + px, y - 5]], color: "#868e96", width: 1.5 },
+    { t: "text", at: [x + px + 6, y + 1], text: label, color: "#6c757d", size },
+  ];
+}
+
+/** A bar of a round length near `target` px: its length, label, and its box in each corner, the
+ * top-left one last (a following camera's note is written there: scaleBar never takes it then). */
+function barLayout(view, size, target) {
+  const metres = target / view.scale;
+  const p = 10 ** Math.floor(Math.log10(metres));
+  const nice = [1, 2, 5, 10].map((k) => k * p).filter((v) => v <= metres).pop() || p;
   const px = nice * view.scale;
   const label = nice >= 1 ? `${nice} m` : nice >= 0.01 ? `${Math.round(nice * 100)} cm` : `${nice} m`;
   const width = px + 6 + 0.6 * size * label.length;
-  // (not the top-left corner: the canvas's notes are written there)
-  const corners = [[14, view.h - 14], [view.w - 14 - width, view.h - 14], [view.w - 14 - width, 14 + size]];
-  const boxOf = ([x, y]) => [x, y - Math.max(size, 5), x + width, y + 4];
-  const free = (b) => !occupied.some((o) => b[0] < o[2] && b[2] > o[0] && b[1] < o[3] && b[3] > o[1]);
-  const [x, y] = corners.find((c) => free(boxOf(c))) || corners[0];
-  occupied.push(boxOf([x, y]));
-  out.push({ t: "poly", pts: [[x, y - 5], [x, y], [x + px, y], [x + px, y - 5]], color: "#868e96", width: 1.5 });
-  out.push({ t: "text", at: [x + px + 6, y + 1], text: label, color: "#6c757d", size });
+  const middle = (view.h + size) / 2;
+  const corners = [[14, view.h - 14], [view.w - 14 - width, view.h - 14], [view.w - 14 - width, 14 + size],
+    [14, middle], [view.w - 14 - width, middle], [14, 14 + size]];
+  return { px, label, boxes: corners.map(([x, y]) => [x, y - Math.max(size, 5), x + width, y + 4]) };
+}
+
+/** [length, corner]: the first bar length with a corner no body covers at any sample of the run
+ * (each body as drawn: its disc, a sliding block's 1.4× half-width, a wheel's rim; the pulleys),
+ * and its first such corner; null when every place is covered at some sample. */
+function runPlace(geom, view, o, layouts, rad, sliding) {
+  let views = BAR_PLACES.get(geom);
+  if (!views) BAR_PLACES.set(geom, (views = new Map()));
+  const key = [view.w, view.h, view.scale, view.center, o.radius, o.font].join("|");
+  if (views.has(key)) return views.get(key);
+  const boxes = layouts.flat();
+  const hits = boxes.map(() => 0);
+  const overlaps = (b, c) => b[0] < c[2] && b[2] > c[0] && b[1] < c[3] && b[3] > c[1];
+  for (const [p, r] of geom.pulleys) {
+    const [cx, cy] = view.project(geom.at(p, 0));
+    const R = r * view.scale;
+    boxes.forEach((b, k) => { if (overlaps(b, [cx - R, cy - R, cx + R, cy + R])) hits[k] = Infinity; });
+  }
+  const halves = geom.bodies.map((b) => {
+    const r = rad(b.name);
+    const wheel = geom.wheels.has(b.name) ? geom.wheels.get(b.name) * view.scale : 0;
+    return [b.name, Math.max(sliding.has(b.name) ? 1.4 * r : r, wheel)];
+  });
+  for (let i = 0; i < geom.n; i++) {
+    for (const [name, half] of halves) {
+      const [x, y] = view.project(geom.at(name, i));
+      boxes.forEach((b, k) => { if (overlaps(b, [x - half, y - half, x + half, y + half])) hits[k] += 1; });
+    }
+  }
+  const per = layouts[0].length;
+  const k = hits.indexOf(0);
+  // covered somewhere whatever the length and place (a chaotic bob sweeps a small canvas): a
+  // place per frame, clear of the bodies where they are now
+  const choice = k < 0 ? null : [Math.floor(k / per), k % per];
+  views.set(key, choice);
+  return choice;
 }
