@@ -46,7 +46,7 @@ def test_the_reasons_are_typeset_with_no_caret_left_in_the_words(server, page):
     rate = f"{math.sqrt(9.81 / 1.0):.4g}"  # √(g/l), the scene's g = 9.81 and l = 1
     assert rf"e^{{{rate}\,t}}" in tex and rf"\lambda = \pm {rate}i" in tex
     # K is explained the first time, as math, by the Hessian of V (a potential stands behind it)
-    assert r"K = \partial^2 V/\partial q^2" in found[0]["math"]
+    assert r"\mathbf K = \partial^2 V/\partial q^2" in found[0]["math"]  # bold: a matrix
     assert "stiffness matrix" in found[0]["words"] and "stiffness" not in found[1]["words"]
     assert page.errors == []
 
@@ -56,6 +56,6 @@ def test_a_turning_frame_glosses_k_by_the_effective_potential(server, page):
     found = reasons(page, server, "bead_on_hoop")
     first = found[0]
     assert "Hessian of the effective potential" in first["words"]
-    assert r"K = \partial^2 V/\partial q^2" not in first["math"]
+    assert r"\mathbf K = \partial^2 V/\partial q^2" not in first["math"]
     assert all("^" not in r["words"] for r in found)
     assert page.errors == []
