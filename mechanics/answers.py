@@ -114,7 +114,7 @@ def to_convention_mapped(
     # follow decides if the text reads one way only. A power never does (`cos θ^3`: cos³θ or
     # cos(θ³)?); a factor does after a coordinate (`sin θ φ'`, `cos θ (1 - cos θ)`: a product,
     # as the notes write sin²θ φ̇²), not after a number or a parameter (`sin 2 θ`, `cos w t`:
-    # cos(w t) to the student, cos(w)·t to a parser)
+    # cos(w t) to the student, cos(w)·t to a parser), nor `*` after them (`cos 2*θ` alike)
     bare: tuple[str, int] | None = None
     depth = 0
     pos = 0
@@ -158,6 +158,9 @@ def to_convention_mapped(
             product = out[bare[1]][1] in coordinates
             if kind == "num" or (value == "(" and not product):
                 raise argument_refused("(...)" if value == "(" else value, at)
+            if kind == "op" and value == "*" and not product:  # cos 2*θ: cos(2θ) or cos(2)·θ?
+                after = _next_token(text, pos)
+                raise argument_refused("*" + ("(...)" if after == "n" else after), at)
             if kind == "op":
                 bare = None
         if power == "":  # sin^ was the last thing: a whole number must come
@@ -256,6 +259,8 @@ def _ambiguous_argument(function: str, argument: str, after: str) -> str:
     would judge some student wrongly, so the student says which."""
     if after.startswith("^"):
         one, other = f"{function}({argument}){after}", f"{function}({argument}{after})"
+    elif after.startswith("*"):
+        one, other = f"{function}({argument}{after})", f"{function}({argument}){after}"
     else:
         one, other = f"{function}({argument} {after})", f"{function}({argument}) {after}"
     return (

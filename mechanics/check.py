@@ -480,6 +480,28 @@ def _number_at(expr: sp.Expr, state: dict) -> float:
     return value.real if abs(value.imag) <= 1e-12 * max(1.0, abs(value.real)) else math.nan
 
 
+def scene_dimensions(model: Any) -> dict[sp.Expr, units.Dim]:
+    """The units of every parameter, coordinate, its rates and t, from the scene's `units`;
+    {} when the scene gives none (or not for all): then no term's units can be judged."""
+    m = model
+    dims: dict[sp.Expr, units.Dim] = {}
+    try:
+        for name, sym in m.params.items():
+            if name in m.spec.units:
+                dims[sym] = units.parse_unit(m.spec.units[name])
+        for name, q, qd, qdd in zip(m.coordinate_names, m.q, m.qd, m.qdd, strict=True):
+            if name not in m.spec.units:
+                return {}
+            base = units.parse_unit(m.spec.units[name])
+            dims[q] = base
+            dims[qd] = (base[0], base[1], base[2] - 1)
+            dims[qdd] = (base[0], base[1], base[2] - 2)
+    except units.UnitError:
+        return {}
+    dims[t] = (0, 0, 1)
+    return dims if len(dims) >= len(m.params) + 3 * len(m.q) + 1 else {}
+
+
 class _Judge:
     def __init__(
         self,
@@ -1584,23 +1606,7 @@ class _Judge:
         )
 
     def _dimensions(self) -> dict[sp.Expr, units.Dim]:
-        m = self.m
-        dims: dict[sp.Expr, units.Dim] = {}
-        try:
-            for name, sym in m.params.items():
-                if name in m.spec.units:
-                    dims[sym] = units.parse_unit(m.spec.units[name])
-            for name, q, qd, qdd in zip(m.coordinate_names, m.q, m.qd, m.qdd, strict=True):
-                if name not in m.spec.units:
-                    return {}
-                base = units.parse_unit(m.spec.units[name])
-                dims[q] = base
-                dims[qd] = (base[0], base[1], base[2] - 1)
-                dims[qdd] = (base[0], base[1], base[2] - 2)
-        except units.UnitError:
-            return {}
-        dims[t] = (0, 0, 1)
-        return dims if len(dims) >= len(m.params) + 3 * len(m.q) + 1 else {}
+        return scene_dimensions(self.m)
 
     def _quantity_dimension(self, dims: dict[sp.Expr, units.Dim]) -> units.Dim | None:
         """The units of the quantity asked for when its derived value is 0: an energy for T, V

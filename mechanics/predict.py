@@ -40,8 +40,9 @@ import sympy as sp
 from scipy.integrate import DOP853, solve_ivp
 from scipy.optimize import brentq
 
+from mechanics import units
 from mechanics.answers import read_answer
-from mechanics.check import check, expected_quantity
+from mechanics.check import check, expected_quantity, scene_dimensions
 from mechanics.derive import Derivation
 from mechanics.expr import ExprError, to_latex
 from mechanics.model import T as t
@@ -627,7 +628,9 @@ def predict(
         "parting_rule": rule,
         **energy,
         "blamed": blamed,
-        "summary": _summary(parted_at, student, energy, blamed, true, t_end),
+        "summary": _summary(
+            parted_at, student, energy, blamed, true, t_end, energy_unit=_energy_unit(d)
+        ),
     }
 
 
@@ -663,6 +666,7 @@ def _summary(
     blamed: str | None,
     true: Run | None = None,
     t_end: float | None = None,
+    energy_unit: str = "",
 ) -> str:
     """One sentence a student reads first (math as $…$). When a run stopped before t_end
     without blowing up (a stop of the scene, too many steps), the comparison covers only the
@@ -675,18 +679,24 @@ def _summary(
     if parted_at is not None:
         parts.append(f"it parts visibly from the true motion at t = {_seconds(parted_at)} s")
     change, most = energy["energy_change"], energy["energy_change_max"]
+    # the yardstick as a number the student can place: its unit, and the time it is taken over
+    # when the comparison stops short of the run (a stop, or the answer's own run ending)
+    scale = f"{energy['energy_scale']:.3g}{' ' + energy_unit if energy_unit else ''}"
+    over = ""
+    if true is not None and t_end is not None and len(true.t) and true.t[-1] < t_end * (1 - 1e-9):
+        over = f" up to t = {_seconds(float(true.t[-1]))} s"
     if abs(change) >= 1e-3:
         verb = "creates" if change > 0 else "destroys"
         parts.append(
             f"measured with the true energy, your model {verb} energy: {_pct(abs(change))} of the "
-            f"true motion's largest kinetic energy ({energy['energy_scale']:.3g}) "
+            f"true motion's largest kinetic energy{over} ({scale}) "
             f"in {_seconds(energy['energy_until'])} s"
             + (f" (up to {_pct(most)} along the way)" if most > 1.5 * abs(change) else "")
         )
     elif most >= 1e-3:
         parts.append(
             f"measured with the true energy, your model's energy swings by up to {_pct(most)} "
-            f"of the true motion's largest kinetic energy ({energy['energy_scale']:.3g})"
+            f"of the true motion's largest kinetic energy{over} ({scale})"
         )
     window = _ends(true, student) if true is not None else ""
     if not window and true is not None and t_end is not None and student.blew_up_at is None:
@@ -703,6 +713,15 @@ def _summary(
     text = text[0].upper() + text[1:]
     cause = f" The cause: {blamed[0].lower() + blamed[1:]}" if blamed else ""
     return f"{text}.{window}{cause}"
+
+
+def _energy_unit(d: Derivation) -> str:
+    """'J' when the scene's units make T an energy in SI (kg·m²/s²), else "": a scene without
+    units has numbers only, and one in other units is not guessed at."""
+    dims = scene_dimensions(d.model)
+    if dims and units.dimension(sp.expand(d.work.T), dims) == (1, 2, -2):
+        return "J"
+    return ""
 
 
 def _seconds(t: float) -> str:
