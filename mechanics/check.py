@@ -502,6 +502,10 @@ def scene_dimensions(model: Any) -> dict[sp.Expr, units.Dim]:
     return dims if len(dims) >= len(m.params) + 3 * len(m.q) + 1 else {}
 
 
+#: The units of a pure number, said so in feedback ("has units dimensionless" read badly).
+NO_UNITS: units.Dim = (0, 0, 0)
+
+
 class _Judge:
     def __init__(
         self,
@@ -619,15 +623,22 @@ class _Judge:
         the rest of the answer is judged on its own: 'Extra term −kx' alone would hide the why.
         """
         q = self.m.q[self.j]
-        conservative = -partial(self.d.work.V, q, self.m)
-        if conservative == 0:
+        force = -partial(self.d.work.V, q, self.m)
+        if force == 0:
             return False
-        rest = self.given - self.expected - conservative
-        whole = self.same(rest, sp.S.Zero)
-        if whole and zero_proof(rest, self.m) is not True:
+        # −∂V/∂q, or +∂V/∂q: the same part with the force's sign lost (−g (m₁ − m₂) for the
+        # Atwood machine's g (m₁ − m₂)), as common and as much not asked for
+        for conservative in (force, -force):
+            rest = self.given - self.expected - conservative
+            whole = self.same(rest, sp.S.Zero)
+            if whole and zero_proof(rest, self.m) is not True:
+                continue
+            if not whole and not self._holds_terms(self.given - self.expected, conservative):
+                continue
+            break
+        else:
             return False
-        if not whole and not self._holds_terms(self.given - self.expected, conservative):
-            return False
+        flipped = conservative != force
         spec = self.m.spec
         sources = [w for w, has in (("gravity", spec.gravity), ("springs", spec.springs)) if has]
         name = to_latex(q)
@@ -637,9 +648,15 @@ class _Judge:
             ending = "; without that part your answer would be right."
         elif not whole:
             ending = "; without that part, your answer still differs:"
+        origin = "/".join(sources) or "gravity/springs"
         fb.append(
-            f"Your answer includes the conservative part $-\\partial V/\\partial {name} = "
-            f"{shown}$ ({'/'.join(sources) or 'gravity/springs'}), which is already in V: only "
+            f"Your answer includes $+\\partial V/\\partial {name} = {shown}$: the conservative "
+            f"part ({origin}) with its sign flipped (the force is $-\\partial V/\\partial "
+            f"{name}$), and that part is already in V: only the non-conservative part "
+            f"$Q_{{{name}}}^{{NC}}$ is asked for" + ending
+            if flipped
+            else f"Your answer includes the conservative part $-\\partial V/\\partial {name} = "
+            f"{shown}$ ({origin}), which is already in V: only "
             f"the non-conservative part $Q_{{{name}}}^{{NC}}$ is asked for" + ending
         )
         if not whole:
@@ -1488,6 +1505,8 @@ class _Judge:
                 fb.append(f"Sign error in the {self._show(term)} term{self._moved(mono)}.")
             elif r.is_number and r != 1:
                 fb.append(f"The term {self._show(term)} is off by a factor of {inline(r)}.")
+            elif r != 1 and mono == 1:  # no motion to name the term by: the values themselves
+                fb.append(self._in_place_of(g[mono], coeff))
             elif r != 1:
                 fb.append(
                     f"The term {self._show(term)} has the coefficient "
@@ -1499,6 +1518,23 @@ class _Judge:
                     f"Extra term {self._show(coeff * mono)}: the correct answer has none like it."
                 )
         return fb
+
+    def _in_place_of(self, mine: sp.Expr, theirs: sp.Expr) -> str:
+        """The part free of the motion compared as values ('the term X has the coefficient Y
+        instead of X' named the whole answer as its own coefficient). A q̈ of ±g is named for
+        what it is: a free fall, the body alone, with the rest of the system left out."""
+        gravity = self.m.spec.gravity
+        g = self.m.params.get(str(gravity.acceleration)) if gravity else None
+        free_fall = g is not None and self.given in (g, -g) and mine == self.given
+        if self.quantity == "accel" and free_fall:
+            qdd = to_latex(self.m.qdd[self.j])
+            return (
+                f"Your ${qdd} = {to_latex(self.given)}$ is the free-fall value, as if the body "
+                f"fell alone; the correct ${qdd} = {to_latex(_tidy(self.expected, self.m))}$: the "
+                "rest of the system is missing (the other bodies' inertia, and the forces they "
+                "pass on through the constraints)."
+            )
+        return f"You have {self._show(mine)} where {self._show(theirs)} belongs."
 
     def _source(self, mono: sp.Expr) -> str:
         if self.quantity not in ("T", "L"):
@@ -1635,13 +1671,14 @@ class _Judge:
             want = units.dimension(reference, dims)
         if want is None:
             return []
+        unit = "a pure number" if want == NO_UNITS else units.fmt(want)
         what = {
             "T": "an energy",
             "V": "an energy",
             "L": "an energy",
-            "eom": f"{units.fmt(want)} like the rest of the equation",
-            "accel": f"{units.fmt(want)} (an acceleration of {inline(self.m.q[self.j or 0])})",
-        }.get(self.quantity, units.fmt(want))
+            "eom": f"{unit} like the rest of the equation",
+            "accel": f"{unit} (an acceleration of {inline(self.m.q[self.j or 0])})",
+        }.get(self.quantity, unit)
         # the terms as written (a sum inside a power is one term that mixes units), and a few
         # of them: a hostile (a + b + …)**30 must not become thousands of lines
         wrong = []
@@ -1659,10 +1696,8 @@ class _Judge:
                     "a dimensional argument to a function)."
                 )
             else:
-                fb.append(
-                    f"The term {_as_written(term)} has units {units.fmt(have)}, not {what}: "
-                    "it cannot belong here."
-                )
+                has = "is a pure number" if have == NO_UNITS else f"has units {units.fmt(have)}"
+                fb.append(f"The term {_as_written(term)} {has}, not {what}: it cannot belong here.")
         if len(wrong) > MAX_UNIT_LINES:
             fb.append(f"… and {len(wrong) - MAX_UNIT_LINES} more terms with the wrong units.")
         return fb
