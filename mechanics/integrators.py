@@ -31,6 +31,7 @@ class MethodInfo:
     label: str
     kind: str  # "fixed" | "adaptive"
     order: int
+    #: symplectic in (q, q̇) for a constant mass matrix only: the methods step q̇, not p = M q̇
     symplectic: bool
     implicit: bool
     description: str
@@ -44,14 +45,19 @@ METHODS: dict[str, MethodInfo] = {
             "One slope per step. Cheap and simple, but the energy of an oscillator grows "
             "every step: the textbook example of what not to integrate orbits with."),
         MethodInfo("symplectic_euler", "Semi-implicit (symplectic) Euler", "fixed", 1, True, False,
-            "Update the velocity first, then the position with the new velocity. Still first "
-            "order, yet the energy error stays bounded over very long runs."),
+            "Update the velocity first, then the position with the new velocity. First order; "
+            "symplectic only when the mass matrix is constant (Cartesian-like coordinates: "
+            "springs, a simple pendulum), where its energy error stays bounded over very long "
+            "runs. With a mass matrix that depends on the coordinates (double pendulum, cart "
+            "pendulum) it steps q̇, not the momenta, and its energy drifts."),
         MethodInfo("rk4", "Classical Runge–Kutta (RK4)", "fixed", 4, False, False,
             "Four slopes per step: very accurate per step, but in long conservative runs the "
             "energy drifts slowly one way."),
         MethodInfo("implicit_midpoint", "Implicit midpoint", "fixed", 2, True, True,
-            "Symplectic and time-reversible: conserves quadratic invariants exactly and keeps "
-            "the energy error bounded; each step solves a small nonlinear system."),
+            "Time-reversible, and symplectic when the mass matrix is constant (Cartesian-like "
+            "coordinates), where it keeps the energy error bounded; it steps (q, q̇), not the "
+            "momenta, so with a mass matrix that depends on the coordinates it is not "
+            "symplectic in general. Each step solves a small nonlinear system."),
         MethodInfo("RK45", "Dormand–Prince 5(4) (scipy RK45)", "adaptive", 5, False, False,
             "scipy's general-purpose default: adapts the step to meet rtol/atol."),
         MethodInfo("DOP853", "Dormand–Prince 8(5,3) (scipy DOP853)", "adaptive", 8, False, False,
@@ -462,7 +468,8 @@ def _euler(f, t, y, h, n):
 
 
 def _symplectic_euler(f, t, y, h, n):
-    """v ← v + h a(q, v); q ← q + h v_new (extra states: explicit Euler). Order 1, symplectic."""
+    """v ← v + h a(q, v); q ← q + h v_new (extra states: explicit Euler). Order 1; symplectic
+    only for a constant mass matrix (v, not p = M(q) v, is what it steps)."""
     new = y + h * f(t, y)
     new[:n] = y[:n] + h * new[n : 2 * n]
     return new
@@ -478,7 +485,8 @@ def _rk4(f, t, y, h, n):
 
 
 def _implicit_midpoint(f, t, y, h, n):
-    """y1 = y + h f(t + h/2, (y + y1)/2): order 2, symplectic, A-stable, time-reversible.
+    """y1 = y + h f(t + h/2, (y + y1)/2): order 2, A-stable, time-reversible; symplectic in
+    (q, q̇) only when the mass matrix is constant.
 
     Fixed-point iteration (it contracts when h·|∂f/∂y|/2 < 1) to 1e-14 relative; if it has not
     converged in 50 iterations or diverges (stiff problems), Newton's method with a

@@ -8,6 +8,7 @@ Nothing here differentiates energies; the steps do that from the model.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -432,7 +433,24 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
 INERTIA_ROUNDING = 1e-9
 
 
-def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[str, str]]:
+def _start_numbers(model: Model, initial: dict[str, float] | None) -> dict[Any, Any]:
+    """t = 0 and the initial state (q, q̇), as a substitution for a limit written in them."""
+    init = {**model.spec.initial, **(initial or {})}
+    numbers: dict[Any, Any] = {T: sp.Float(0)}
+    for name, qi, vi in zip(model.coordinate_names, model.q, model.qd, strict=True):
+        numbers[vi] = sp.Float(init.get(f"{name}_dot", 0.0))
+        numbers[qi] = sp.Float(init.get(name, 0.0))
+    return numbers
+
+
+def _moves(value: Any, model: Model) -> bool:
+    """Whether a limit's expression depends on t or the state (checked along the run too)."""
+    return isinstance(value, sp.Basic) and value.has(T, *model.q)
+
+
+def physical_limit_errors(
+    model: Model, values: dict[str, float], initial: dict[str, float] | None = None
+) -> list[dict[str, str]]:
     """What no real system has, at these parameter values, each naming its field.
 
     The per-parameter sign checks see only a parameter standing alone (k = "k"); written as a
@@ -441,23 +459,32 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
     negative mass ("m - 2" at m = 1) was blamed on the initial state. A central
     inertia tensor must be positive semidefinite with principal moments obeying the triangle
     inequality (I₁ + I₂ ≥ I₃: ∫(x² + y²) dm ≤ ∫(y² + z²) dm + ∫(z² + x²) dm). A value that
-    depends on the state or on t is left to the mass-matrix and run checks.
+    depends on the state or on t ("k*(x - 1)", "m*(t - 2)") is taken at the run's start, t = 0
+    and the initial state (the spec's, with ``initial`` over it), and along the run by
+    `limits_along_run`.
     """
     numbers = {model.params[k]: sp.Float(v) for k, v in values.items() if k in model.params}
+    start = _start_numbers(model, initial)
     errors: list[dict[str, str]] = []
 
     def number(e: Any) -> float | None:
         try:
-            return float(e.xreplace(numbers))
+            return float(e.xreplace(numbers).xreplace(start))
         except (TypeError, ValueError):
             return None
 
     for where, what, value in model.limits:
+        entries = value.values() if isinstance(value, dict) else [value]
+        at = " at t = 0 s and the initial state" if any(_moves(v, model) for v in entries) else ""
         if isinstance(value, dict):
-            errors += _inertia_errors(where, what, {k: number(v) for k, v in value.items()})
+            entries = {k: number(v) for k, v in value.items()}
+            errors += _inertia_errors(where, what + at, entries)
             continue
         x = number(value)
-        if x is None or x >= 0:
+        # a mass of 0 in the parameters is the mass matrix's to refuse (it names the coordinate
+        # left without inertia); one that is 0 at the start only (m (θ − 2) at θ0 = 2) is this
+        zero_here = x == 0 and bool(at) and where.endswith(".mass")
+        if x is None or (x >= 0 and not zero_here):
             continue
         alone = str(value) if value in model.params.values() else None
         hint = (
@@ -465,7 +492,7 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
             if where == "gravity.acceleration"
             else ""
         )
-        shown = "" if alone or value.is_number else f" ({to_plain(value)} at these parameters)"
+        shown = "" if alone or value.is_number else f" ({to_plain(value)} at these parameters{at})"
         # a mass of 0 is the mass matrix's to refuse (it names the coordinate left without
         # inertia); a negative one is no body at all
         bound = "> 0" if where.endswith(".mass") else "≥ 0"
@@ -476,6 +503,85 @@ def physical_limit_errors(model: Model, values: dict[str, float]) -> list[dict[s
             }
         )
     return errors
+
+
+@lru_cache(maxsize=256)
+def _along(value: sp.Expr, q: tuple, qd: tuple, params: tuple) -> Any:
+    """value as a numpy function of (t, q, q̇, parameters), each an array over the samples."""
+    t, qs, vs = sp.Dummy("t"), [sp.Dummy() for _ in q], [sp.Dummy() for _ in qd]
+    plain = value.xreplace(dict(zip(qd, vs, strict=True))).xreplace(
+        {T: t, **dict(zip(q, qs, strict=True))}
+    )
+    return sp.lambdify((t, qs, vs, list(params)), plain, "numpy")
+
+
+def limits_along_run(
+    model: Model, values: dict[str, float], t: np.ndarray, q: np.ndarray, qd: np.ndarray
+) -> list[str]:
+    """A warning for each limit written in t or the state that a run's samples carry below 0.
+
+    The start is refused by `physical_limit_errors`; past it a stiffness "k*(x - 1)" or an
+    inertia "a*cos(t)" may still turn negative, and the run goes on integrating equations of
+    no real system (the physical pendulum with izz = cos t reached M = 0 at t = 1.823 s and was
+    told as a blow-up 'fed by a force'). Named by field and time, so the cause is the one seen.
+    """
+    names = list(model.params)
+    args = (tuple(model.q), tuple(model.qd), tuple(model.params[k] for k in names))
+    p = [np.full(len(t), float(values[k])) for k in names]
+    warnings: list[str] = []
+
+    def along(e: Any) -> np.ndarray:
+        out = _along(e, *args)(t, list(q), list(qd), p)
+        return np.broadcast_to(np.asarray(out, dtype=float), t.shape)
+
+    for where, what, value in model.limits:
+        entries = value if isinstance(value, dict) else {"": value}
+        if not any(_moves(v, model) for v in entries.values()):
+            continue
+        with np.errstate(all="ignore"):
+            try:
+                series = {k: along(v) for k, v in entries.items()}
+            except (TypeError, ValueError, ZeroDivisionError):
+                continue
+        if isinstance(value, dict):
+            bad = [(k, series[k]) for k in ("ixx", "iyy", "izz") if _moves(value[k], model)]
+            rows = (("ixx", "ixy", "izx"), ("ixy", "iyy", "iyz"), ("izx", "iyz", "izz"))
+            tensors = np.stack([np.stack([series[k] for k in row], -1) for row in rows], -2)
+            ok = np.all(np.isfinite(tensors), axis=(-2, -1))
+            low = np.full(len(t), np.inf)
+            low[ok] = np.linalg.eigvalsh(tensors[ok])[:, 0]
+            high = np.abs(tensors).max(axis=(-2, -1))
+            bad.append(("", np.where(low < -INERTIA_ROUNDING * high, -1.0, 1.0)))
+        else:
+            bad = [("", series[""])]
+        for key, x in bad:
+            strict = where.endswith(".mass")
+            # a mass reaching 0 ends the motion's description as surely as a negative one;
+            # to rounding of its start (m (1 − t/2) at a failed step 1e-9 s short of t = 2)
+            zero = 1e-6 * abs(float(x[0])) if strict and np.isfinite(x[0]) else 0.0
+            hit = np.nonzero(x <= zero if strict else x < 0)[0]
+            if not len(hit):
+                continue
+            i = int(hit[0])
+            field = f"{where}.{key}" if key else where
+            one = value[key] if key else None if isinstance(value, dict) else value
+            shown = to_plain(one) if one is not None else None
+            if shown is None:
+                warnings.append(
+                    f"{field} ({what}) is not positive semidefinite by t = {t[i]:.3g} s: no "
+                    "mass distribution has such a tensor, so the run from there on is not the "
+                    "motion of a real body."
+                )
+                break
+            said = f"{field} = {shown}"
+            state = "negative" if x[i] < 0 else "0"
+            warnings.append(
+                f"{said} is {state} by t = {t[i]:.3g} s ({x[i]:.3g} there): no real system has "
+                f"{what} {'below' if state == 'negative' else 'at'} 0, so the run from there on "
+                "is not the motion of one."
+            )
+            break
+    return warnings
 
 
 def _inertia_errors(where: str, what: str, entries: dict[str, float | None]) -> list[dict]:

@@ -20,7 +20,8 @@ from scipy.integrate import cumulative_simpson
 from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.expr import to_plain
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
-from mechanics.model import physical_limit_errors
+from mechanics.model import T as T_SYMBOL
+from mechanics.model import limits_along_run, physical_limit_errors
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
     EXTREME_EXPONENT,
@@ -120,7 +121,8 @@ def check_request(c: CompiledScene, req: SimulationRequest) -> tuple[list[float]
     if errors:
         raise SpecError(errors)
     values = {**spec.parameters, **req.parameters}
-    errors += physical_limit_errors(c.derivation.model, values)  # at these values, not the spec's
+    # at these values and this start (a limit in t or q at t = 0, q0), not the spec's
+    errors += physical_limit_errors(c.derivation.model, values, req.initial)
     init = {**spec.initial, **req.initial}
     for q in spec.positive_coordinates:
         if init.get(q, 0.0) <= 0:
@@ -452,6 +454,21 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         stop = StopEvent(at_start.name, at_start.message, 0.0, run)
     if stop is not None:
         run = stop.run
+    # a limit written in t or q that the run carries below 0 (k (x − 1) past x = 1): named
+    # first, since a failure past it is that limit's doing, not a force's or a stiffness's
+    values = dict(zip(c.parameters, params, strict=True))
+    n = c.n
+    t_seen, y_seen = run.t, run.y
+    if run.status != "ok" and run.y_reached is not None and math.isfinite(run.t_reached):
+        # a failed run's last step lies past its last sample: a mass "m (1 − t/2)" reaches 0
+        # at the failure (t = 2 s) and at no sample before it
+        t_seen = np.append(run.t, run.t_reached)
+        y_seen = np.vstack([run.y, np.asarray(run.y_reached)[None, : run.y.shape[1]]])
+    unphysical = limits_along_run(
+        c.derivation.model, values, t_seen, y_seen[:, :n].T, y_seen[:, n : 2 * n].T
+    )
+    warnings += unphysical
+    if stop is not None:
         warnings.append(f"Stopped at t = {stop.t:.4g} s: {stop.message}.")
     elif run.status != "ok":
         overflow = _overflowed(c, params, req, run)
@@ -459,7 +476,9 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
             raise SpecError([overflow])
         said = run.message.rstrip(".")  # scipy's messages end in a full stop of their own
         warnings.append(f"The run stopped early: {said}. The trajectory is partial.")
-        if overflow is not None:
+        if unphysical:
+            pass  # the limit's warning says why: a blow-up's or stiffness's advice would mislead
+        elif overflow is not None:
             warnings.append(overflow["message"][0].upper() + overflow["message"][1:] + ".")
         else:
             warnings += _why_it_stopped(c, params, req, run)
@@ -614,7 +633,8 @@ def _accuracy_warning(
         lo, hi = float(np.min(error)), float(np.max(error))
         if start is not None:
             lo, hi = lo + start, hi + start
-        why = "a symplectic method's bounded error" if method.symplectic else "a bounded error"
+        symplectic = method.symplectic and constant_mass_matrix(c)
+        why = "a symplectic method's bounded error" if symplectic else "a bounded error"
         return (
             f"{name} oscillates between {_apart(lo, hi, lo)}{unit} and {_apart(hi, lo, hi)}{unit}, "
             f"within {of_scale}, "
@@ -630,13 +650,20 @@ def _accuracy_warning(
         )
     when = f"by t = {t[worst]:.3g} s"
     if trend == "grows":
-        if method.symplectic:
+        if method.symplectic and not constant_mass_matrix(c):
+            better = (
+                f"take {shrink} or a higher-order method ({req.method} is symplectic only "
+                "when the mass matrix is constant, and this scene's depends on the coordinates)"
+            )
+        elif method.symplectic:
             better = f"take {shrink}"
-        elif fixed:
+        elif fixed and constant_mass_matrix(c):
             better = (
                 f"take {shrink}, or a symplectic method (symplectic_euler, implicit_midpoint) "
-                "whose energy error stays bounded"
+                "whose energy error stays bounded for this scene's constant mass matrix"
             )
+        elif fixed:
+            better = f"take {shrink} or a higher-order method"
         else:
             better = f"ask for {shrink} or a higher-order method"
         return (
@@ -644,6 +671,16 @@ def _accuracy_warning(
             f"length of the run: {better}."
         )
     return f"{name} {change} {when}, {of_scale}: ask for {shrink} or a higher-order method."
+
+
+def constant_mass_matrix(c: CompiledScene) -> bool:
+    """Whether M is free of the coordinates and t. symplectic_euler (v ← v + h a, q ← q + h v)
+    and implicit_midpoint step (q, q̇), not (q, p): only when M is constant is that a linear
+    change of the canonical variables, so only then are they symplectic (on the double
+    pendulum symplectic_euler's E drifts from 0.149 J to −26.5 J by t = 60 s)."""
+    m = c.derivation.model
+    M = c.derivation.work.mass_matrix
+    return M is not None and not any(entry.has(T_SYMBOL, *m.q) for entry in M)
 
 
 def _apart(a: float, b: float, x: float) -> str:
@@ -654,28 +691,57 @@ def _apart(a: float, b: float, x: float) -> str:
     return f"{x:.{digits}g}"
 
 
-#: A drift: the error's largest size over the run's second half exceeds the first half's by
-#: more than this, and it never comes back below half of the first half's largest. A linear
-#: drift doubles from one half to the next, explicit Euler's at least that; a symplectic
-#: method's oscillation reaches the same peaks in both halves (1.00 on the simple pendulum) and
-#: returns near 0 at every turning point.
+#: A drift: the error's size over the second half of the run exceeds the first half's by more
+#: than this, and never comes back below half of the first half's largest. A linear drift
+#: doubles from one half to the next, explicit Euler's at least that.
 DRIFT_GROWTH = 1.25
+#: A bounded oscillation reaches the same floor and the same ceiling in both halves of the run,
+#: to this share of its range: a symplectic method's does (the simple pendulum's to 1e-3), while
+#: a secular trend moves the floor or ceiling, whether or not the peaks grow (explicit Euler on
+#: the double pendulum: peaks 60 J → 76 J, floor −0.7 J → 30 J).
+SAME_ENVELOPE = 0.1
+#: A secular trend: the mean of the signed error moves by more than this share of the first
+#: half's range, the same way through each quarter of the run. A bounded oscillation with at
+#: least a swing in each half moves its half-means by at most about a third of its range.
+TREND_SHIFT = 0.5
+#: The same, with a floor risen this share of the first half's range clear of 0 over the whole
+#: second half.
+FLOOR_SHIFT = 0.25
 
 
 def _error_trend(error: np.ndarray, qd: np.ndarray) -> str:
-    """ "grows", "bounded" (an oscillation that returns near 0 and reaches no higher peaks in the
-    second half of the run) or "unknown". Told only when the first half holds at least a swing
-    (two turning points of some velocity): before that a bounded error has not shown its
-    range, and an oscillation still rising to its first peak would read as a drift."""
+    """ "grows", "bounded" or "unknown": "bounded" only when nothing a growing error would do
+    shows (the floor, the ceiling and the peaks of the second half all those of the first), so
+    no criterion a drift can pass calls it bounded; "unknown" tells the numbers alone.
+
+    Told only when the first half holds at least a swing (two turning points of some velocity):
+    before that a bounded error has not shown its range, and an oscillation still rising to its
+    first peak would read as a drift."""
     half = len(error) // 2
-    if half < 4 or _turning_points(qd[:, :half]) < 2:
+    if half < 8 or _turning_points(qd[:, :half]) < 2:
         return "unknown"
+    first, second = error[:half], error[half:]
     size = np.abs(error)
-    first, second = float(np.max(size[:half])), float(np.max(size[half:]))
-    lowest = float(np.min(size[half:]))
-    if second > DRIFT_GROWTH * first and lowest > 0.5 * first:
+    peak1, peak2 = float(np.max(size[:half])), float(np.max(size[half:]))
+    if peak2 > DRIFT_GROWTH * peak1 and float(np.min(size[half:])) > 0.5 * peak1:
         return "grows"
-    if second <= DRIFT_GROWTH * first and lowest < 0.5 * second:
+    lo1, hi1 = float(np.min(first)), float(np.max(first))
+    lo2, hi2 = float(np.min(second)), float(np.max(second))
+    spread = max(hi1 - lo1, 1e-300)
+    means = [float(np.mean(part)) for part in np.array_split(error, 4)]
+    steps = np.diff(means)
+    monotone = bool(np.all(steps > 0) or np.all(steps < 0))
+    shift = means[-1] - means[0]
+    if monotone and abs(shift) > TREND_SHIFT * spread:
+        return "grows"
+    # a floor (or ceiling) that has left the start behind: the error started at 0 and the whole
+    # second half stays off it on the trend's side (explicit Euler, double pendulum: ≥ 24.5 J
+    # after a first half spanning −0.85 J to 75 J); a bounded oscillation comes back to its start
+    off = lo2 if shift > 0 else -hi2
+    if monotone and abs(shift) > FLOOR_SHIFT * spread and off > FLOOR_SHIFT * spread:
+        return "grows"
+    same = abs(lo2 - lo1) <= SAME_ENVELOPE * spread and abs(hi2 - hi1) <= SAME_ENVELOPE * spread
+    if same and peak2 <= DRIFT_GROWTH * peak1 and float(np.min(size[half:])) < 0.5 * peak2:
         return "bounded"
     return "unknown"
 
@@ -910,7 +976,11 @@ def _sensitivity(c, params, y0, t_eval, req, run) -> list[str]:
     drift, told as timing), or not at all; see mechanics/divergence.py. A run cut by a stop is
     compared over the samples both runs share.
     """
+    # 1000× looser, capped at 1e-3; a run already at or past the cap is compared with one 10×
+    # looser (at rtol 1e-3 the capped re-run was the run itself: 'at rtol 0.001 and 0.001')
     rtol, atol = min(req.rtol * 1e3, 1e-3), min(req.atol * 1e3, 1e-3)
+    if rtol <= req.rtol:
+        rtol, atol = min(req.rtol * 10, 1.0), min(max(req.atol, atol) * 10, 1.0)
     loose = _run(c, params, y0, t_eval, req, rtol, atol)
     shared = min(len(loose.t), len(run.t) - (1 if run.status == "stopped" else 0))
     if loose.status != "ok" and len(loose.t) < len(run.t) or shared < 3:

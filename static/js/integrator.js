@@ -7,7 +7,9 @@ export const METHODS = [
   ["RK45", "RK45 — adaptive, order 5"], ["Radau", "Radau — implicit, stiff"],
   ["BDF", "BDF — implicit, stiff"], ["LSODA", "LSODA — switches when stiff"],
   ["rk4", "RK4 — fixed step, order 4"], ["euler", "Euler — fixed step, order 1"],
-  ["symplectic_euler", "symplectic Euler — fixed step"], ["implicit_midpoint", "implicit midpoint — fixed step"],
+  // symplectic only where the mass matrix is constant (Cartesian-like coordinates): they step q̇, not p
+  ["symplectic_euler", "symplectic Euler — fixed step, symplectic if M is constant"],
+  ["implicit_midpoint", "implicit midpoint — fixed step, symplectic if M is constant"],
 ];
 const FIXED = new Set(["rk4", "euler", "symplectic_euler", "implicit_midpoint"]);
 export const isFixed = (method) => FIXED.has(method);
