@@ -382,8 +382,27 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
         shown = f"{to_latex(d.model.qdd[j])} = {shown}"
     verdict = Verdict(False, answer_latex=shown, expected_latex=_latex(d, quantity, j))
     judge = _Judge(d, quantity, j, expected, given, moved)
+    judge.typed_terms = _typed_terms(answer)
     judge.run(verdict)
     return verdict
+
+
+def _typed_terms(answer: str) -> int:
+    """How many terms the student typed at the top level (outside parentheses): sympy adds
+    ½ m ẋ² + ½ (m R²)(ẋ/R)² into m ẋ² before the checker sees it, and whether they wrote one
+    term or several decides if 'off by a factor' can be said of the whole."""
+    count, depth, previous = 1, 0, ""
+    for k, ch in enumerate(answer):
+        if ch in "([{":
+            depth += 1
+        elif ch in ")]}":
+            depth -= 1
+        elif ch in "+-" and depth == 0 and previous not in ("", "(", "*", "/", "^", "=", "+", "-"):
+            exponent = previous in "eE" and k >= 2 and answer[k - 2].isdigit()
+            count += 0 if exponent else 1
+        if not ch.isspace():
+            previous = ch
+    return count
 
 
 def _parse_position(text: str, model: Any) -> sp.Expr:
@@ -523,6 +542,7 @@ class _Judge:
         # the units of the student's own scaling of it (set in _eom)
         self.reference = expected
         self.scale: sp.Expr = sp.S.One  # the student's scaling of an equation of motion
+        self.typed_terms = len(sp.Add.make_args(given))  # check() counts them in the text
         rng = random.Random(0)
         self.limits = _domain_limits(self.m)
         self.states = [self._inside_state(rng, {}) for _ in range(SAMPLES)]
@@ -1248,6 +1268,9 @@ class _Judge:
         if near:  # its terms would read as missing and extra, its units as mixed: neither is
             fb.append(near)
             return
+        if self.quantity in ("T", "L") and self._rotation(given, expected, fb):
+            fb += self._units(given)
+            return
         ratio = self._ratio(given, expected)
         # a fixed multiple of the derived result approximates nothing: the approximation is
         # looked for only when there is no one factor (and its proofs cost a second on a q̈)
@@ -1286,6 +1309,50 @@ class _Judge:
         fb += self._units(given)
         if not fb:
             fb.append("Not equal to the derived result at the states sampled.")
+
+    def _rotation(self, given: sp.Expr, expected: sp.Expr, fb: list[str]) -> bool:
+        """A rigid body's ½ ω·I_G·ω (notes eq. 25) left out, or written with another I, while
+        the rest of T is right: the rolling disk's ½ m ẋ² + ½ (m R²)(ẋ/R)² is 4/3 of T, but
+        'every term is 4/3 times what it should be' blames ½ m ẋ², which is right. A sum the
+        student wrote is judged so; a single term that is a multiple of T stays 'off by a
+        factor' (there is no telling which part it meant), unless it is exactly T without the
+        rotation (½ m v_G² alone). Proved, not sampled."""
+        m = self.m
+        several = max(self.typed_terms, len(self._surface(given))) > 1
+        for body in m.bodies:
+            if body.frame is None:
+                continue
+            w = body.frame.ang_vel_in(m.N)
+            spin = w.dot(w)
+            rotation = w.dot(body.inertia.dot(w)) / 2
+            if rotation == 0 or spin == 0:
+                continue
+            rest = given - (expected - rotation)  # what the student has for the rotation
+            c = self._ratio(rest, rotation)
+            if c is None or c == 1 or (c != 0 and not several):
+                continue
+            if zero_proof(rest - c * rotation, m) is not True:
+                continue
+            moment = _tidy(2 * rotation / spin, m)
+            name = body.name
+            if c == 0:
+                v = m.velocity(name)
+                moving = body.mass * v.dot(v) != 0
+                there = f"½ m v_G² of the {name} is there, but " if moving else ""
+                fb.append(
+                    f"{there[0].upper() + there[1:] if there else ''}"
+                    f"{'the' if there else 'The'} rotation of the {name} about its centre of "
+                    f"mass G, ½ I_G ω² = {self._show(rotation)} (I_G = {inline(moment)}), is "
+                    f"missing: a rigid body's T is ½ m v_G² + ½ I_G ω² (eq. 25)."
+                )
+                return True
+            fb.append(
+                f"The rotation's ½ I ω² term of the {name} is not right: you have I = "
+                f"{self._show(c * moment)} where {inline(moment)} (the {name}'s I about its "
+                f"centre of mass) belongs. The rest of your {self.quantity} is right."
+            )
+            return True
+        return False
 
     def _canonical(self, expr: sp.Expr) -> dict[sp.Expr, sp.Expr]:
         """_canonical_form, once per expression per check (feedback asks for it repeatedly)."""
