@@ -161,11 +161,14 @@ def test_a_parameter_named_e_or_q_leaves_those_letters_to_it(damped):
     conserved, forces = step(spec, "conserved"), step(spec, "forces")
     for s in (conserved, forces):
         _, maths = words_and_math(s["text"])
-        assert not any(re.search(r"(?<![\\{A-Za-z])[EQ](?![A-Za-z])", m) for m in maths), maths
+        # E and Q as the energy or a generalized force (E =, dE/dt, Q_j, Q^NC), never the
+        # parameters E and Q themselves (the spring's −E x may appear)
+        energy_or_force = r"(?<![\\{A-Za-z])(?:d?E\s*=|dE/dt|Q_|Q\^)"
+        assert not any(re.search(energy_or_force, m) for m in maths), maths
     assert r"\mathcal{Q}_j" in forces["text"] and "named Q" in forces["text"]
     assert forces["latex"] == [r"\mathcal{Q}_{x}^{NC} = " + ("- Q \\dot{x}" if damped else "0")]
     if damped:  # energy changes: dE/dt = Σ Q_j q̇_j
-        assert r"d\mathcal{E}/dt = \sum_j \mathcal{Q}_j \dot q_j" in conserved["text"]
+        assert r"d\mathcal{E}/dt = \sum_j \mathcal{Q}_j^{NC} \dot q_j" in conserved["text"]
     else:  # the energy line: 𝓔 = T + V = ½ m ẋ² + ½ E x², E the parameter
         (line,) = conserved["latex"]
         assert line.startswith(r"\mathcal{E} = T + V = ") and "named E" in conserved["text"]
