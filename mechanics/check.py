@@ -1405,8 +1405,64 @@ class _Judge:
         for velocity in dict.fromkeys([*map(self._velocity, e), *map(self._velocity, g)]):
             mine = {k: v for k, v in g.items() if self._velocity(k) == velocity}
             theirs = {k: v for k, v in e.items() if self._velocity(k) == velocity}
-            fb += self._group_terms(velocity, mine, theirs) or self._piece_terms(mine, theirs)
+            lines = self._group_terms(velocity, mine, theirs) or self._piece_terms(mine, theirs)
+            if lines:
+                lines = self._as_typed(velocity, given, expected) or lines
+            fb += lines
         return fb
+
+    def _light(self, expr: sp.Expr) -> dict[sp.Expr, sp.Expr]:
+        """monomial -> coefficient as the student wrote the functions: products and powers of
+        sums multiplied out, but sin²θ and cos(θ₁ − θ₂) kept whole (the canonical form rewrites
+        them, and its pieces are terms nobody typed). {} past the size budget."""
+        if _expansion_size(expr, 8 * MAX_TERMS) > 8 * MAX_TERMS:
+            return {}
+        dynamic = (*self.m.q, *self.m.qd, *self.m.qdd, t)
+        out: dict[sp.Expr, sp.Expr] = {}
+        for term in sp.Add.make_args(sp.expand(expr)):
+            coeff, mono = term.as_independent(*dynamic, as_Add=False)
+            out[mono] = out.get(mono, 0) + coeff
+        return {k: v for k, v in out.items() if sp.simplify(v) != 0}
+
+    def _as_typed(self, velocity: sp.Expr, given: sp.Expr, expected: sp.Expr) -> list[str]:
+        """The group's difference in the student's own terms, when the canonical pieces are not
+        them: expanding sin²θ into 1 − cos²θ, or cos(θ₁ − θ₂) into cos θ₁ cos θ₂ + sin θ₁ sin θ₂,
+        made 'Extra term m g l/2' of a term nobody typed. [] when nothing was rewritten (the
+        pieces are the student's terms, and their lines say it as well)."""
+        g = {k: c for k, c in self._light(given).items() if self._velocity(k) == velocity}
+        e = {
+            k: c
+            for k, c in self._light(_tidy(expected, self.m, factor_whole=False)).items()
+            if self._velocity(k) == velocity
+        }
+        if not g or len(g) + len(e) > MAX_TERMS:
+            return []
+        if all(len(self._canonical(k)) <= 1 for k in (*g, *e)):
+            return []  # nothing was rewritten: the pieces are the terms
+        fb = []
+        for k in [k for k in e if k in g and sp.simplify(g[k] - e[k]) != 0]:
+            fb.append(self._one_for_one(g[k] * k, e[k] * k))
+        extra = [c * k for k, c in g.items() if k not in e]
+        missing = [c * k for k, c in e.items() if k not in g]
+        if extra and missing and self.same(sp.Add(*extra), sp.Add(*missing)):
+            return fb  # written otherwise (1 − cos²θ for sin²θ), not wrong
+        if len(extra) == 1 and len(missing) == 1:
+            return [*fb, self._one_for_one(extra[0], missing[0])]
+        fb += [f"Extra term {self._show(w)}: the correct answer has none like it." for w in extra]
+        fb += [f"Missing term {self._show(x)}{self._source(velocity)}." for x in missing]
+        return fb
+
+    def _one_for_one(self, mine: sp.Expr, theirs: sp.Expr) -> str:
+        """One term of the student's against the one the derivation has in its place."""
+        ratio = self._fixed_ratio(self.values(mine), self.values(theirs))
+        if ratio == -1:
+            return f"Sign error in your term {self._show(mine)}: it should be {self._show(theirs)}."
+        if ratio is not None:
+            return (
+                f"Your term {self._show(mine)} is off by a factor of {inline(ratio)}: it should "
+                f"be {self._show(theirs)}."
+            )
+        return f"You have {self._show(mine)} where {self._show(theirs)} belongs."
 
     def _small_angle(self, given: sp.Expr, expected: sp.Expr) -> str:
         """A sentence when the answer is the derived result with sin x ≈ x, cos x ≈ 1 (or
