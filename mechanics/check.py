@@ -1328,6 +1328,13 @@ class _Judge:
             if rotation == 0 or spin == 0:
                 continue
             rest = given - (expected - rotation)  # what the student has for the rotation
+            datum = sp.S.Zero
+            if self.quantity == "L":  # a constant in L only moves V's datum: not the rotation's
+                at_rest = {x: 0 for x in (*m.q, *m.qd, *m.qdd)}
+                datum = rest.xreplace(at_rest)
+                if datum.has(sp.zoo, sp.nan) or datum.has(t):
+                    continue
+                rest -= datum
             c = self._ratio(rest, rotation)
             if c is None or c == 1 or (c != 0 and not several):
                 continue
@@ -1349,7 +1356,8 @@ class _Judge:
             fb.append(
                 f"The rotation's ½ I ω² term of the {name} is not right: you have I = "
                 f"{self._show(c * moment)} where {inline(moment)} (the {name}'s I about its "
-                f"centre of mass) belongs. The rest of your {self.quantity} is right."
+                f"centre of mass) belongs. The rest of your {self.quantity} is right"
+                + (" (up to a constant, which only moves V's datum)." if datum != 0 else ".")
             )
             return True
         return False

@@ -113,6 +113,15 @@ def test_a_mis_sized_disk_inertia_is_the_rotation_term():
     assert sp.latex(m * R**2) in text and sp.latex(m * R**2 / 2) in text, lines
 
 
+def test_the_disk_inertia_in_l_is_named_past_the_datum():
+    # L = T − V with V = −m g x sin α (x down the slope) and the scene's own datum left out
+    lines, text = feedback(
+        "rolling_disk", "L", "1/2 m x'^2 + 1/2 (m R^2)(x'/R)^2 + m g x sin(alpha)"
+    )
+    assert "factor" not in text and "rotation" in text, lines
+    assert sp.latex(m * R**2 / 2) in text and "datum" in text, lines
+
+
 def test_a_single_term_off_by_a_factor_still_reads_as_one():
     x_dot = sp.Symbol("xd")
     right = sp.Rational(1, 2) * m * x_dot**2 + sp.Rational(1, 2) * (m * R**2 / 2) * (x_dot / R) ** 2
