@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+import sympy as sp
 from fastapi import FastAPI
 from fastapi.testclient import TestClient
 
@@ -311,3 +312,28 @@ def test_runs_are_compared_only_up_to_where_the_model_ends():
     assert out["error_scale"] < 1 + r0 + math.sqrt(2 * g * r0 / math.tan(alpha)) * 2
     steady = precision("simple_pendulum", None, PrecisionRequest(methods=["rk4"]))
     assert steady["stopped"] is None and steady["t_end"] == 10
+
+
+def test_symplectic_is_claimed_only_where_the_mass_matrix_is_constant():
+    """Symplectic Euler steps (q, q̇): a linear change of the canonical (q, p) only when
+    p = M q̇ with M constant. The pendulum's M = m l² is; the double pendulum's off-diagonal
+    m₂ l₁ l₂ cos(θ₁ − θ₂) is not (by hand), so there neither the method's row nor the long run
+    may call it symplectic."""
+    t1, t2 = sp.symbols("theta1 theta2")
+    m2, l1, l2 = sp.symbols("m2 l1 l2", positive=True)
+    assert sp.diff(m2 * l1 * l2 * sp.cos(t1 - t2), t1) != 0
+    for scene_id, constant in (("simple_pendulum", True), ("double_pendulum", False)):
+        out = precision(
+            scene_id,
+            request=PrecisionRequest(
+                methods=["symplectic_euler"], t_end=1.0, steps=[0.01], long_run=True
+            ),
+        )
+        assert fitted(out, "symplectic_euler")["symplectic"] is constant, scene_id
+        assert out["long_run"]["symplectic_here"] is constant, scene_id
+    # and through the API, whose schema keeps the field
+    body = {"scene_id": "double_pendulum", "methods": ["symplectic_euler"], "t_end": 1.0}
+    r = client.post("/api/v1/precision", json={**body, "steps": [0.01], "long_run": True})
+    assert r.status_code == 200, r.text
+    assert r.json()["long_run"]["symplectic_here"] is False
+    assert r.json()["methods"][0]["symplectic"] is False

@@ -92,7 +92,10 @@ class MethodPoints(BaseModel):
     label: str
     kind: str
     order: int = Field(description="The method's order (the registry's).")
-    symplectic: bool
+    symplectic: bool = Field(
+        description="Symplectic on this scene: a symplectic method stepping (q, q̇) is only "
+        "where the mass matrix is constant."
+    )
     fitted_order: float | None = Field(
         description="Least-squares slope of log error against log h (fixed step), or minus the "
         "slope against log RHS evaluations (adaptive); null with < 2 points in the fit."
@@ -103,6 +106,10 @@ class MethodPoints(BaseModel):
 
 
 class LongRunOut(BaseModel):
+    symplectic_here: bool = Field(
+        description="Whether symplectic Euler is symplectic on this scene: it steps (q, q̇), "
+        "which is a linear change of (q, p) only where the mass matrix is constant."
+    )
     period: float
     period_from: str
     periods: int

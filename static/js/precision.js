@@ -206,6 +206,10 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
     longBox.replaceChildren(
       el("h3", { textContent: `Long run: ${lr.periods} periods at h = ${num(lr.h)} s (period ${num(lr.period)} s, from ${lr.period_from})` }),
       el("p", { textContent: `${line("symplectic_euler")}; ${line("rk4")}.` }),
+      // stepping (q, q̇), symplectic Euler is symplectic only where the mass matrix is constant
+      ...(lr.symplectic_here === false ? [el("p", { className: "muted", textContent:
+        "Here the mass matrix changes with the coordinates, so symplectic Euler (which steps q and q̇, "
+        + "not the momenta) is not symplectic: its energy error is not bound to stay bounded." })] : []),
       el("div", { className: "plot", id: "precision-plot-long" }));
   }
 
