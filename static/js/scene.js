@@ -664,10 +664,11 @@ function inlineData() {
   };
 }
 
-/** How many steps to typeset in one go. Each MathJax call measures the page's layout once, so
- * one call per step costs the double pendulum a third more than a few calls in all; but one call
- * for everything holds the main thread (and the animation) for a quarter of a second. So steps
- * are grouped to about BATCH_MS of work each, at the pace this machine was seen to typeset. */
+/** How many steps to typeset in one go. Each MathJax call measures the page's layout once: on a
+ * loaded machine the double pendulum's steps in one call took about a quarter less time than one
+ * call per step (on a quiet one the difference was within the noise), but one call for everything
+ * holds the main thread (and the animation) for a quarter of a second. So steps are grouped to
+ * about BATCH_MS of work each, at the pace this machine was seen to typeset. */
 const BATCH_MS = 50;
 
 function typesetPace() {
