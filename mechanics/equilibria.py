@@ -46,7 +46,7 @@ from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
 from mechanics.steps import Line, Step, tidy
 from mechanics.steps.conserved import explicit_time
-from mechanics.steps.forces import derived_letter
+from mechanics.steps.energy import letter
 
 SYMBOLIC_OPS_LIMIT = 200
 TOL = 1e-9
@@ -207,7 +207,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         if verdict.pole and not _held_at_pole(d, variant, q0, values):
             warnings.append(
-                f"Every ${derived_letter(m, 'Q')}_j$ vanishes at {_point_text(m, q0)}, a pole "
+                f"Every ${letter(m, 'Q')}_j$ vanishes at {_point_text(m, q0)}, a pole "
                 "of the coordinates, only "
                 "because they cannot move in every direction there: beside it the forces do not "
                 "shrink to 0 (a force or torque acts along a direction they lose there), so it is "
@@ -368,7 +368,7 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
     names = ", ".join(m.coordinate_names[j] for j in idle)
     if everything:
         return (
-            f"No force acts at rest at these parameters (every ${derived_letter(m, 'Q')}_j$ "
+            f"No force acts at rest at these parameters (every ${letter(m, 'Q')}_j$ "
             r"vanishes at $\dot q = 0$): "
             "every configuration is an equilibrium (a family), none held by a restoring force: the "
             "list shows one of them, and what a nudge does there."
@@ -527,7 +527,7 @@ def _virtual_work_step(d: Derivation, conditions: list[sp.Expr]) -> Step:
     key = tuple(conditions)
     if key not in known:
         known[key] = _virtual_work_lines(d, conditions)
-    Q, V = derived_letter(d.model, "Q"), derived_letter(d.model, "V")
+    Q, V = letter(d.model, "Q"), letter(d.model, "V")
     # the forces step's own notation: Q_j is every applied force, Q_j^{NC} the part not in V
     text = (
         "Constraint forces do no virtual work, so only the applied forces enter: "
@@ -562,7 +562,7 @@ def _virtual_work_lines(d: Derivation, conditions: list[sp.Expr]) -> list[Line]:
 
 def _condition_lines(d: Derivation, conditions: list[sp.Expr], where: str = "") -> list[Line]:
     m = d.model
-    Q = derived_letter(m, "Q")
+    Q = letter(m, "Q")
     return [
         Line(
             f"Q_{name} at rest{where}",
@@ -1245,7 +1245,7 @@ def _power_symbol(m: Any, at_rest: bool = True) -> str:
     """The power of the velocity-dependent forces in the forces step's letters. Q_j there is
     every applied force (Q_j^NC − ∂V/∂q_j), so the sum is over Q_j^NC, less its part at rest when
     a force acts at rest too (a wind and its drag): that part is in K, not in this power."""
-    Q = derived_letter(m, "Q")
+    Q = letter(m, "Q")
     if at_rest:
         return rf"\sum_j ({Q}_j^{{NC}} - {Q}_j^{{NC}}|_{{\dot q = 0}})\,\dot q_j"
     return rf"\sum_j {Q}_j^{{NC}} \dot q_j"  # as the conserved step writes dE/dt

@@ -8,7 +8,7 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.model import T as t
 from mechanics.steps import Line, Step, Work, tidy
-from mechanics.steps.forces import derived_letter, letters_note
+from mechanics.steps.energy import letter, script_note
 
 
 def explicit_time(expr: sp.Expr, model: Model) -> bool:
@@ -36,7 +36,7 @@ def conserved_quantities(model: Model, work: Work) -> Step:
     """E = T + V, or the Jacobi integral h, when no force does work (eq. 23); p_j of a cyclic
     coordinate. E, T, V, L and Q are written script where the scene has a parameter of that
     name, as in the energy step, so that "E = T + V" never adds a parameter to energies."""
-    E_, T_, V_, L_, Q_ = (derived_letter(model, n) for n in ("E", "T", "V", "L", "Q"))
+    E_, T_, V_, L_, Q_ = (letter(model, n) for n in ("E", "T", "V", "L", "Q"))
     lines: list[Line] = []
     found: list[dict] = []
     no_nc = all(Q == 0 for Q in work.Q)
@@ -122,5 +122,5 @@ def conserved_quantities(model: Model, work: Work) -> Step:
             rf"$p_j = \partial {L_}/\partial \dot q_j$."
         )
     text = " ".join(parts)
-    used = [n for n in ("E", "T", "V", "L", "Q") if derived_letter(model, n) in text]
-    return Step("conserved", "Conserved quantities", text + letters_note(model, *used), lines)
+    used = [n for n in ("E", "T", "V", "L", "Q") if letter(model, n) in text]
+    return Step("conserved", "Conserved quantities", text + script_note(model, *used), lines)

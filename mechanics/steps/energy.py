@@ -9,18 +9,34 @@ from mechanics.model import Model, reference_value
 from mechanics.steps import Line, Step, Work, eq_line, sub, tidy
 
 #: Letters the derivation gives a meaning of its own: T and V the energies, L the Lagrangian.
-ENERGY_LETTERS = {"T": r"\mathcal{T}", "V": r"\mathcal{V}", "L": r"\mathcal{L}"}
+#: The letters a scene's own parameter or coordinate may take, and what the derivation writes
+#: for the quantity instead.
+SCRIPT_LETTERS = {
+    "T": r"\mathcal{T}",
+    "V": r"\mathcal{V}",
+    "L": r"\mathcal{L}",
+    "E": r"\mathcal{E}",
+    "Q": r"\mathcal{Q}",
+}
+MEANINGS = {
+    "T": "kinetic energy",
+    "V": "potential energy",
+    "L": "Lagrangian",
+    "E": "energy",
+    "Q": "generalized forces",
+}
 
 
 def letter(model: Model, name: str) -> str:
-    """T, V or L as the derivation prints it: script when the scene has a parameter or coordinate
-    of that name, so that "L = L m (…)" never reads as one symbol with two meanings.
+    """T, V, L, E or Q as the derivation prints it: script when the scene has a parameter or
+    coordinate of that name, so that "L = L m (…)" never reads as one symbol with two meanings
+    (nor a posted force Q as the Q_j beside it).
 
     A posted spec may well call a length L (a textbook does); refusing it would turn away a
     correct scene, so the energy takes the other letter instead.
     """
     taken = set(model.spec.parameters) | set(model.spec.coordinates)
-    return ENERGY_LETTERS[name] if name in taken else name
+    return SCRIPT_LETTERS[name] if name in taken else name
 
 
 def script_note(model: Model, *names: str) -> str:
@@ -28,8 +44,9 @@ def script_note(model: Model, *names: str) -> str:
     taken = [n for n in names if letter(model, n) != n]
     if not taken:
         return ""
-    meaning = {"T": "kinetic energy", "V": "potential energy", "L": "Lagrangian"}
-    written = " and ".join(f"the {meaning[n]} as ${ENERGY_LETTERS[n]}$" for n in taken)
+    written = " and ".join(
+        f"the {MEANINGS[n]} as ${letter(model, n)}{'_j' if n == 'Q' else ''}$" for n in taken
+    )
     return (
         f" The scene has a parameter or coordinate named {' and '.join(taken)}, so this "
         f"derivation writes {written}."

@@ -21,7 +21,6 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
 from mechanics.steps.energy import letter
-from mechanics.steps.forces import derived_letter
 
 #: A kinematic quantity counts as zero when it is below this at every sampled state.
 ZERO = 1e-9
@@ -471,7 +470,7 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     heights = "every body at the height of O" if model.gravity is not None else ""
     rest = "every spring at its rest length" if model.springs else ""
     V = letter(model, "V")
-    Q_ = derived_letter(model, "Q")
+    Q_ = letter(model, "Q")
     datum = (
         f"${V} = 0$ with {' and '.join(filter(None, [heights, rest]))}"
         if heights or rest

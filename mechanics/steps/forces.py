@@ -7,41 +7,7 @@ import sympy as sp
 from mechanics.expr import to_latex
 from mechanics.model import Model
 from mechanics.steps import Step, Work, eq_line, partial, tidy
-from mechanics.steps.energy import ENERGY_LETTERS, letter
-
-#: E (the energy) and Q (the generalized forces) take a script form by energy.letter's rule.
-OTHER_LETTERS = {"E": r"\mathcal{E}", "Q": r"\mathcal{Q}"}
-MEANINGS = {
-    "T": "kinetic energy",
-    "V": "potential energy",
-    "L": "Lagrangian",
-    "E": "energy",
-    "Q": "generalized forces",
-}
-
-
-def derived_letter(model: Model, name: str) -> str:
-    """T, V, L, E or Q as the derivation prints it: script when the scene has a parameter or
-    coordinate of that name, so that a posted spec's force Q never reads as the Q_j beside it."""
-    if name in ENERGY_LETTERS:
-        return letter(model, name)
-    taken = set(model.spec.parameters) | set(model.spec.coordinates)
-    return OTHER_LETTERS[name] if name in taken else name
-
-
-def letters_note(model: Model, *names: str) -> str:
-    """The sentence that says which of these letters are script here ('' when none is)."""
-    taken = [n for n in names if derived_letter(model, n) != n]
-    if not taken:
-        return ""
-    written = " and ".join(
-        f"the {MEANINGS[n]} as ${derived_letter(model, n)}{'_j' if n == 'Q' else ''}$"
-        for n in taken
-    )
-    return (
-        f" The scene has a parameter or coordinate named {' and '.join(taken)}, so this "
-        f"derivation writes {written}."
-    )
+from mechanics.steps.energy import letter, script_note
 
 
 def generalized_forces(model: Model, work: Work) -> Step:
@@ -58,8 +24,8 @@ def generalized_forces(model: Model, work: Work) -> Step:
             total += load.vector.dot(partial)
         Q.append(tidy(total, model))
     work.Q = Q
-    Q_, V_ = derived_letter(model, "Q"), derived_letter(model, "V")
-    L_, T_ = derived_letter(model, "L"), derived_letter(model, "T")
+    Q_, V_ = letter(model, "Q"), letter(model, "V")
+    L_, T_ = letter(model, "L"), letter(model, "T")
     # the plain copy says NC as the LaTeX does: a bare Q_x = 0 reads as the whole Q_x
     Q_plain = "Q" if Q_ == "Q" else "script_Q"
     lines = [
@@ -85,7 +51,7 @@ def generalized_forces(model: Model, work: Work) -> Step:
             rf"forces of eq. 31 are then all conservative, ${Q_}_j = -\partial {V_}/\partial q_j$"
             f"{_conservative_example(model, work, Q_, V_)}, and enter through ${V_}$, not here."
         )
-    return Step("forces", "Generalized forces", text + letters_note(model, "Q"), lines)
+    return Step("forces", "Generalized forces", text + script_note(model, "Q"), lines)
 
 
 def _conservative_example(model: Model, work: Work, Q_: str, V_: str) -> str:
