@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import scipy.optimize
 import sympy as sp
+from independent import engine_eigenvalues, first_order_eigenvalues
 from sympy.physics.mechanics import LagrangesMethod, Particle, Point, ReferenceFrame, dynamicsymbols
 
 from mechanics.derive import derivation_of_scene, derive_model
@@ -32,18 +33,6 @@ def at(result: dict, **q) -> dict:
         if all(math.isclose(e["q"][k], v, abs_tol=1e-7) for k, v in q.items()):
             return e
     raise AssertionError(f"no equilibrium at {q}: {[e['q'] for e in result['equilibria']]}")
-
-
-def eigenvalues(M, C, K) -> np.ndarray:
-    """λ of M x'' + C x' + K x = 0, from the first-order form, sorted for comparison."""
-    M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (M, C, K))
-    n = len(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    return np.sort_complex(np.round(np.linalg.eigvals(A), 9))
-
-
-def engine_eigenvalues(e: dict) -> np.ndarray:
-    return np.sort_complex(np.round(np.array([complex(a, b) for a, b in e["eigenvalues"]]), 9))
 
 
 def turntable(omega: float, k: float = 4.0, m: float = 1.0) -> dict:
@@ -87,7 +76,9 @@ def test_turntable_frequencies_are_root_k_over_m_plus_and_minus_omega():
     assert e["frequencies"] == pytest.approx([0.5, 3.5], rel=1e-9)
     assert e["kind"] == "stable" and e["stable"]
     assert "positive definite" in e["reason"]
-    np.testing.assert_allclose(engine_eigenvalues(e), eigenvalues(*turntable_mck(1.5, 4, 4)))
+    np.testing.assert_allclose(
+        engine_eigenvalues(e), first_order_eigenvalues(*turntable_mck(1.5, 4, 4))
+    )
     # a whirl, not a standing pattern: x and y a quarter period apart
     for phases in e["mode_phases"]:
         assert sorted(abs(p) for p in phases) == pytest.approx([0.0, math.pi / 2])
@@ -136,7 +127,7 @@ def test_turntable_against_sympy_lagranges_method():
     K = -np.array(forcing.jacobian([x, y]).subs(rest).subs(values), dtype=float)
     C = -np.array(forcing.jacobian([xd, yd]).subs(rest).subs(values), dtype=float)
     (e,) = solve(turntable(1.5))["equilibria"]
-    np.testing.assert_allclose(engine_eigenvalues(e), eigenvalues(M, C, K), atol=1e-8)
+    np.testing.assert_allclose(engine_eigenvalues(e), first_order_eigenvalues(M, C, K), atol=1e-8)
 
 
 @pytest.mark.parametrize(
@@ -148,7 +139,7 @@ def test_anisotropic_turntable_is_unstable_only_between_the_two_spring_frequenci
     with Re λ > 0 exactly when ab < 0, i.e. 2 < Ω < 3; above 3 both are negative (K negative
     definite) and Coriolis holds it. (The isotropic turntable has no such window: λ = −iΩ ± iω₀.)"""
     (e,) = solve(anisotropic_turntable(omega, 4.0, 9.0))["equilibria"]
-    expected = eigenvalues(*turntable_mck(omega, 4.0, 9.0))
+    expected = first_order_eigenvalues(*turntable_mck(omega, 4.0, 9.0))
     np.testing.assert_allclose(engine_eigenvalues(e), expected, atol=1e-8)
     assert e["kind"] == kind
     assert e["stable"] == (kind != "unstable")

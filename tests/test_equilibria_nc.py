@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import scipy.integrate
 import sympy as sp
+from independent import engine_eigenvalues, first_order_eigenvalues
 from sympy.physics.mechanics import (
     LagrangesMethod,
     Point,
@@ -31,18 +32,6 @@ from mechanics.equilibria import equilibria
 
 def solve(spec: dict, **parameters) -> dict:
     return equilibria(derive_model(spec), parameters)
-
-
-def first_order(M, C, K) -> np.ndarray:
-    """λ of M x'' + C x' + K x = 0, sorted for comparison."""
-    M, C, K = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (M, C, K))
-    n = len(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
-    return np.sort_complex(np.round(np.linalg.eigvals(A), 9))
-
-
-def engine_eigenvalues(e: dict) -> np.ndarray:
-    return np.sort_complex(np.round(np.array([complex(a, b) for a, b in e["eigenvalues"]]), 9))
 
 
 def only(result: dict) -> dict:
@@ -87,7 +76,7 @@ def test_a_force_that_pumps_energy_in_is_not_called_stable():
     e = only(solve(cubic(0.1)))
     assert e["kind"] == "marginal" and not e["stable"], e["reason"]
     assert "no sign" in e["reason"] and r"\sum_j Q_j^{NC} \dot q_j = c \dot{x}^{4}" in e["reason"]
-    assert engine_eigenvalues(e) == pytest.approx(first_order([[1]], [[0]], [[4]]))
+    assert engine_eigenvalues(e) == pytest.approx(first_order_eigenvalues([[1]], [[0]], [[4]]))
 
     assert energy_after(-0.1) < energy_after(0.0)
     e = only(solve(cubic(-0.1)))
@@ -114,12 +103,16 @@ def test_a_negative_power_plus_a_term_that_can_win_is_not_stable():
     e = only(solve(trap(["-c*x_dot + c*x_dot**2", 0, 0])))
     assert e["kind"] == "marginal", e["reason"]
     C = 0.1 * np.array([[1, 0], [0, 0]])
-    assert engine_eigenvalues(e) == pytest.approx(first_order(np.eye(2), C, 4 * np.eye(2)))
+    assert engine_eigenvalues(e) == pytest.approx(
+        first_order_eigenvalues(np.eye(2), C, 4 * np.eye(2))
+    )
 
     e = only(solve(trap(["-c*(x_dot - y_dot)", "c*(x_dot - y_dot)", 0])))
     assert e["kind"] == "stable", e["reason"]
     C = 0.1 * np.array([[1, -1], [-1, 1]])
-    assert engine_eigenvalues(e) == pytest.approx(first_order(np.eye(2), C, 4 * np.eye(2)))
+    assert engine_eigenvalues(e) == pytest.approx(
+        first_order_eigenvalues(np.eye(2), C, 4 * np.eye(2))
+    )
 
 
 @pytest.mark.parametrize(("k", "B", "kind"), [(1.0, 0.5, "stable"), (-1.0, 3.0, None)])
@@ -129,7 +122,7 @@ def test_a_magnetic_force_is_gyroscopic_not_coriolis(k, B, kind):
     frame turns: nothing here is a Coriolis term."""
     e = only(solve(trap(["q*B*y_dot", "-q*B*x_dot", 0], k=k, B=B)))
     C = np.array([[0.0, -B], [B, 0.0]])
-    expected = first_order(np.eye(2), C, k * np.eye(2))
+    expected = first_order_eigenvalues(np.eye(2), C, k * np.eye(2))
     assert engine_eigenvalues(e) == pytest.approx(expected)
     assert np.max(expected.real) <= 1e-9  # B² > 4|k|: every λ on the imaginary axis
     assert e["kind"] == (kind or "gyroscopically stable"), e["reason"]
@@ -179,7 +172,7 @@ def test_follower_load_is_judged_by_the_eigenvalues_not_a_potential(P):
     det K = 1 for every P): the verdict and its reason come from the first-order eigenvalues,
     marginal while they sit on the imaginary axis, flutter once a complex pair crosses."""
     M, K = ziegler_mk(P)
-    expected = first_order(M, np.zeros((2, 2)), K)
+    expected = first_order_eigenvalues(M, np.zeros((2, 2)), K)
     assert np.linalg.det(K) == pytest.approx(1.0)
     if P == 2.2:
         k_eigs = np.linalg.eigvals(K)
