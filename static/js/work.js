@@ -107,15 +107,15 @@ export function showWork(run, { lecture = false } = {}) {
   window.Plotly.react("plot-work", traces, { ...base, margin: top(workTitle), title: title(workTitle), annotations,
     xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis }, CONFIG);
   // A body on a string or rod has a tension (which a string cannot make negative); any other
-  // constraint (a block on an incline, a bead on a hoop) a reaction of magnitude |R|.
+  // constraint (a block on an incline, a bead on a hoop) a reaction of magnitude |F_C| (the FBD's name).
   const forces = run.constraint_forces || {};
   const ctraces = Object.entries(forces).map(([body, f]) => f.tension
     ? { x: t, y: f.tension, name: `tension on ${body}`, mode: "lines" }
-    : { x: t, y: f.x.map((x, k) => Math.hypot(x, f.y[k], f.z[k])), name: `|R| on ${body}`, mode: "lines" });
+    : { x: t, y: f.x.map((x, k) => Math.hypot(x, f.y[k], f.z[k])), name: `|F<sub>C</sub>| on ${body}`, mode: "lines" });
   const tension = Object.values(forces).some((f) => f.tension);
   const constraintTitle = tension
     ? "constraint forces (tension < 0: a string goes slack)"
-    : "constraint forces |R| along the run";
+    : "constraint forces |F<sub>C</sub>| along the run";
   $("plot-constraint").dataset.tension = tension ? "1" : "0";
   window.Plotly.react("plot-constraint", ctraces, { ...base, margin: top(constraintTitle), title: title(constraintTitle),
     xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
