@@ -96,9 +96,14 @@ def client():
         yield c
 
 
-def predict(client, answer: str, **extra) -> dict:
+def post_predict(client, answer: str, **extra):
+    """The Atwood machine's Q_x answer sent to /check/predict (extra: initial, parameters…)."""
     body = {"scene_id": "atwood_machine", "quantity": "Q", "coordinate": "x", "answer": answer}
-    r = client.post("/api/v1/check/predict", json={**body, **extra})
+    return client.post("/api/v1/check/predict", json={**body, **extra})
+
+
+def predict(client, answer: str, **extra) -> dict:
+    r = post_predict(client, answer, **extra)
     assert r.status_code == 200, r.text[:500]
     return r.json()
 
@@ -193,16 +198,7 @@ def test_a_start_past_the_pulley_is_refused_and_one_at_it_ends_at_once(client):
     """As /simulate: x beyond the pulley is a 422 naming the initial state; x at the pulley,
     still rising, ends both motions at t = 0."""
     past = AT_PULLEY["mass2"] + 0.5
-    r = client.post(
-        "/api/v1/check/predict",
-        json={
-            "scene_id": "atwood_machine",
-            "quantity": "Q",
-            "coordinate": "x",
-            "answer": "g (m1-m2)",
-            "initial": {"x": past},
-        },
-    )
+    r = post_predict(client, "g (m1-m2)", initial={"x": past})
     assert r.status_code == 422, r.text[:500]
     (error,) = r.json()["detail"]
     assert error["field"] == "initial" and "mass2" in error["message"]
@@ -214,16 +210,7 @@ def test_a_start_past_the_pulley_is_refused_and_one_at_it_ends_at_once(client):
 def test_masses_of_zero_are_blamed_not_the_strings_tension(client):
     """m₁ = m₂ = 0 leaves x without inertia: the 422 names the parameter, as without stops, not
     the string's tension stop (0/0 there too, but no field the student wrote)."""
-    r = client.post(
-        "/api/v1/check/predict",
-        json={
-            "scene_id": "atwood_machine",
-            "quantity": "Q",
-            "coordinate": "x",
-            "answer": "g (m1-m2)",
-            "parameters": {"m1": 0, "m2": 0},
-        },
-    )
+    r = post_predict(client, "g (m1-m2)", parameters={"m1": 0, "m2": 0})
     assert r.status_code == 422, r.text[:500]
     (error,) = r.json()["detail"]
     assert error["field"].startswith("parameters.m") and "inertia" in error["message"]

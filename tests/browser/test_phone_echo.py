@@ -29,13 +29,19 @@ MATH_IN_RESULT = """(result) => [...result.querySelectorAll('mjx-container')].ma
 })"""
 
 
-def test_a_wide_answer_scrolls_in_its_box_on_a_phone_and_the_page_does_not(server, page, sized):
+def t_box_on_a_phone(server, page, sized):
+    """The double pendulum at 390×844, its first Your-turn box for T opened."""
     sized(390, 844)
     p = page.page
     p.goto(f"{server}/scenes/double_pendulum")
     wait_ready(page)
     box = p.locator(T_BOX).first
     box.locator("summary").click()
+    return p, box
+
+
+def test_a_wide_answer_scrolls_in_its_box_on_a_phone_and_the_page_does_not(server, page, sized):
+    p, box = t_box_on_a_phone(server, page, sized)
     check_answer(p, box, LONG_T)
     result = box.locator(".result")
     maths = result.evaluate(MATH_IN_RESULT)
@@ -68,12 +74,7 @@ def test_a_wide_answer_scrolls_in_its_box_on_a_phone_and_the_page_does_not(serve
 
 
 def test_a_short_answer_on_a_phone_has_no_scroll_cue(server, page, sized):
-    sized(390, 844)
-    p = page.page
-    p.goto(f"{server}/scenes/double_pendulum")
-    wait_ready(page)
-    box = p.locator(T_BOX).first
-    box.locator("summary").click()
+    p, box = t_box_on_a_phone(server, page, sized)
     check_answer(p, box, "1/2 m1 l1^2 theta1'^2")
     maths = box.locator(".result").evaluate(MATH_IN_RESULT)
     echo = [m for m in maths if m["where"] == "echo"]
