@@ -45,7 +45,7 @@ from mechanics.model import T as t
 from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
 from mechanics.steps import Line, Step, tidy
-from mechanics.steps.conserved import explicit_time
+from mechanics.steps.conserved import explicit_time, vanishes
 from mechanics.steps.energy import letter
 
 SYMBOLIC_OPS_LIMIT = 200
@@ -1319,7 +1319,8 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
     if not moves:
         return Power("dissipative" if dampers else "none", symbol=symbol)
     at = sp.expand(power.xreplace(values)) if power != 0 else power
-    if at == 0:  # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0
+    # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0 (case by case where |q̇| or sign(q̇) appear)
+    if at == 0 or _once(d, "vanishes", at, lambda: vanishes(at, m)):
         return Power("dissipative" if dampers else "no work", symbol=symbol)
     proven = _once(d, "never positive", at, lambda: _never_positive(m, at))
     text = f"${symbol} = {_once(d, 'power latex', '', lambda: to_latex(power))}$"

@@ -1,0 +1,132 @@
+"""Three engine trust leftovers: a zero power that has |·| or sgn in it, an inertia that is not
+positive at an equilibrium, and /newton's forces by name.
+
+1. A force c (sgn(ẋ)|ẋ| − ẋ) is 0 for every real ẋ, yet sympy cannot simplify it: the conserved
+   step said it did work and left E off. The zero test must stay sound (a power that is not 0,
+   even only on ẋ = ẏ, is never called 0): each verdict is checked against F·v evaluated by
+   numpy at random states and on every kink (ẋ = 0, ẋ = ẏ, …), F·v written by hand from the
+   spec's strings, not the engine's Q_j.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from mechanics.derive import derive_model
+from mechanics.equilibria import _power_at
+from mechanics.steps.conserved import nc_power
+
+PARAMETERS = {"m": 1.0, "k": 1.0, "c": 0.3}
+
+
+def particle(fx: str, fy: str = "0") -> dict:
+    """A particle in the trap V = k (x² + y²)/2, as a course tool would post it, with one force."""
+    return {
+        "title": "Particle with a force",
+        "coordinates": ["x", "y"],
+        "parameters": PARAMETERS,
+        "bodies": [{"name": "p", "mass": "m", "position": ["x", "y", 0]}],
+        "potentials": [{"name": "trap", "expression": "k*(x**2 + y**2)/2"}],
+        "forces": [{"name": "f", "on": "p", "vector": [fx, fy, 0]}],
+    }
+
+
+#: Forces whose power F·v is 0 at every real state.
+NO_WORK = [
+    "c*(sign(x_dot)*abs(x_dot) - x_dot)",
+    "c*(x_dot*sign(x_dot) - abs(x_dot))",
+    "c*(sign(x_dot - y_dot)*abs(x_dot - y_dot) - x_dot + y_dot)",
+    "c*(sign(x_dot*y_dot)*abs(x_dot*y_dot) - x_dot*y_dot)",
+    "c*sign(x)*(abs(x_dot) - x_dot*sign(x_dot))",
+]
+#: Forces that do work somewhere. The last two do only on a kink: c (|sgn(ẋ − ẏ)| − 1) is −c
+#: on ẋ = ẏ alone, (sgn(ẋ)² − 1) ẏ is −ẏ at ẋ = 0 alone, so the u = 0 case must be judged.
+WORK = [
+    "c*abs(x_dot)",
+    "c*x_dot*abs(x_dot)",
+    "sign(x_dot)",
+    "-c*sign(x_dot)",
+    "c*(sign(x_dot)*abs(x_dot) + x_dot)",
+    "c*(abs(sign(x_dot - y_dot)) - 1)",
+]
+WORK_Y = [("0", "(sign(x_dot)**2 - 1)*y_dot")]
+
+
+def power_by_hand(fx: str, fy: str) -> callable:
+    """F·v = Fx ẋ + Fy ẏ as a numpy function of (x, y, ẋ, ẏ), from the spec's own strings."""
+    x, y, xd, yd = sp.symbols("x y x_dot y_dot", real=True)
+    table = {"x": x, "y": y, "x_dot": xd, "y_dot": yd, "abs": sp.Abs, "sign": sp.sign}
+    table.update({k: sp.Float(v) for k, v in PARAMETERS.items()})
+    power = sp.sympify(fx, locals=table) * xd + sp.sympify(fy, locals=table) * yd
+    return sp.lambdify((x, y, xd, yd), power, "numpy")
+
+
+def states() -> np.ndarray:
+    """Random states, then the same with ẋ = 0, ẏ = 0, ẋ = ẏ, ẋ = −ẏ and x = 0 (the kinks)."""
+    rng = np.random.default_rng(5)
+    s = rng.uniform(-2, 2, size=(4, 40))
+    kinks = [s.copy() for _ in range(5)]
+    kinks[0][2] = 0
+    kinks[1][3] = 0
+    kinks[2][2] = kinks[2][3]
+    kinks[3][2] = -kinks[3][3]
+    kinks[4][0] = 0
+    return np.concatenate([s, *kinks], axis=1)
+
+
+def verdicts(fx: str, fy: str = "0") -> tuple[bool, str, str]:
+    """Is E listed as conserved, the conserved step's text, and equilibria's power kind at 0."""
+    d = derive_model(particle(fx, fy))
+    step = next(s for s in d.steps if s.id == "conserved")
+    values = {d.model.params[k]: sp.Float(v) for k, v in PARAMETERS.items()}
+    kind = _power_at(d, values, [0.0, 0.0]).kind
+    # the engine's power is F·v too (so the numbers below judge the verdict on the same thing)
+    engine = sp.lambdify(
+        (*d.model.q, *d.model.qd), nc_power(d.model, d.work).xreplace(values), "numpy"
+    )
+    X = states()
+    assert np.allclose(
+        np.broadcast_to(engine(*X), X.shape[1]), power_by_hand(fx, fy)(*X), atol=1e-12
+    )
+    return any(c["name"] == "energy" for c in d.work.conserved), step.text, kind
+
+
+@pytest.mark.parametrize("force", NO_WORK)
+def test_a_force_that_does_no_work_case_by_case_keeps_energy_conserved(force):
+    """F·v is 0 at every sampled state and on every kink, so E = T + V is conserved: the step
+    lists it and says no work is done, and equilibria's power is "no work" (it was "no sign")."""
+    P = np.broadcast_to(power_by_hand(force, "0")(*states()), states().shape[1])
+    assert np.max(np.abs(P)) <= 1e-12, force  # the premise, checked independently of the engine
+    conserved, text, kind = verdicts(force)
+    assert conserved and "do no work" in text and "do work" not in text, text
+    assert kind == "no work", force
+
+
+@pytest.mark.parametrize(("fx", "fy"), [(f, "0") for f in WORK] + WORK_Y)
+def test_a_force_that_does_work_somewhere_is_never_called_workless(fx, fy):
+    """F·v ≠ 0 at some state (for the last ones only on ẋ = ẏ or ẋ = 0): E is not conserved, the
+    step says the forces do work, and equilibria never calls the power 0."""
+    P = power_by_hand(fx, fy)(*states())
+    assert np.max(np.abs(P)) > 1e-3, (fx, fy)  # the premise
+    conserved, text, kind = verdicts(fx, fy)
+    assert not conserved and "do work" in text, text
+    assert kind not in ("no work", "none"), (fx, fy)
+
+
+def test_the_step_says_the_force_itself_is_zero_not_gyroscopic():
+    """c (sgn(ẋ)|ẋ| − ẋ) is no magnetic force: it is 0 itself, and the text says which."""
+    _, text, _ = verdicts(NO_WORK[0])
+    assert "themselves are 0" in text and "magnetic" not in text, text
+
+
+def test_a_force_at_rest_alone_does_no_work_there():
+    """c (|sgn ẋ| − 1) is −c at ẋ = 0 only, where its power −c ẋ is 0: E is conserved (the
+    case ẋ = 0 is judged, not skipped), the force is not 0 itself. Equilibria judges the part
+    that moves, c |sgn ẋ|, whose power c ẋ has no sign: rightly not "no work" there."""
+    force = "c*(abs(sign(x_dot)) - 1)"
+    assert np.max(np.abs(power_by_hand(force, "0")(*states()))) <= 1e-12
+    conserved, text, kind = verdicts(force)
+    assert conserved and "do no work" in text and "themselves are 0" not in text, text
+    assert kind == "no sign"
