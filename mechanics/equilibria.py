@@ -42,6 +42,7 @@ from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
 from mechanics.expr import parse, to_latex, to_plain
 from mechanics.model import T as t
+from mechanics.model import _inertia_errors
 from mechanics.numeric import overflow_error
 from mechanics.spec import SpecError
 from mechanics.steps import Line, Step, tidy
@@ -174,6 +175,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         found = found[:MAX_EQUILIBRIA]
     free = sorted({j for j, c in enumerate(conditions) if c == 0} | set(idle))
     results, verdicts = [], []
+    left_out = False  # balanced where the system has no state: "never balance" would be false
     for variant, root in found:
         q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
         where = _undefined_position(m, q0, values)
@@ -184,6 +186,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 "logarithm of a negative number): the system has no such state, so it is "
                 "left out."
             )
+            left_out = True
+            continue
+        unphysical = _unphysical_inertia(m, variant.mass_matrix, q0, values)
+        if unphysical is not None:
+            warnings.append(
+                f"The forces balance at {_point_text(m, q0)}, but {unphysical}, so the point "
+                "is left out."
+            )
+            left_out = True
             continue
         try:
             with np.errstate(all="ignore"):
@@ -234,6 +245,11 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         )
     if results:  # a family is said only where one of its members is listed
         warnings[:0] = families
+    elif left_out:
+        warnings.append(
+            "No equilibrium the system can be in: the forces balance only at the states left out "
+            "above."
+        )
     elif not dry and not any(w.startswith(_EDGE) for w in warnings):
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
@@ -317,6 +333,63 @@ def _undefined_position(m: Any, q0: list[float], values: dict) -> str | None:
                 return name
             if not (math.isfinite(z.real) and abs(z.imag) <= 1e-12 * max(1.0, abs(z.real))):
                 return name
+    return None
+
+
+def _singular_at(mass_matrix: sp.Matrix, at: dict) -> bool:
+    """Is M singular at this state (smallest eigenvalue ≤ 1e-12 × largest), or not a number?"""
+    try:
+        M = np.array(mass_matrix.xreplace(at).evalf(), dtype=float)
+    except (TypeError, ValueError):
+        return False
+    eig = np.linalg.eigvalsh((M + M.T) / 2)
+    return bool(np.all(np.isfinite(eig))) and eig[0] <= 1e-12 * max(abs(eig[-1]), 1e-300)
+
+
+def _unphysical_inertia(
+    m: Any, mass_matrix: sp.Matrix, q0: list[float], values: dict
+) -> str | None:
+    """What is wrong at q0 with a mass or inertia that depends on the coordinates, naming its
+    field; None if nothing is. The request's own state is refused by the physical-limit checks
+    (422), but an equilibrium elsewhere can sit where m (2 − x) is −1: its linearization then
+    answered "unstable" for a body that cannot exist, or "stable" with no inertia at all."""
+    at = {**values, **{q: sp.Float(x) for q, x in zip(m.q, q0, strict=True)}}
+    at[m.names["t"]] = sp.S.Zero
+
+    def number(e: Any) -> float | None:
+        try:
+            x = float(e.xreplace(at))
+        except (TypeError, ValueError):
+            return None
+        return x if math.isfinite(x) else None
+
+    for where, what, value in m.limits:
+        entries = value if isinstance(value, dict) else {"": value}
+        moving = [k for k, v in entries.items() if isinstance(v, sp.Basic) and v.has(*m.q)]
+        if not where.endswith((".mass", ".inertia")) or not moving:
+            continue
+        here = {k: number(v) for k, v in entries.items()}
+        if where.endswith(".mass"):
+            x = here[""]
+            if x is not None and x <= 0:
+                return f"{what} {to_plain(value)} is {x:g} there ({where}): a mass must be > 0"
+            continue
+        for k in (k for k in ("ixx", "iyy", "izz") if k in moving):
+            x = here[k]
+            if x is not None and x < 0:
+                return (
+                    f"{what} has {k} = {to_plain(entries[k])} = {x:g} there ({where}.{k}): a "
+                    "moment of inertia is ∫ r² dm ≥ 0"
+                )
+            if x == 0 and _singular_at(mass_matrix, at):  # ≥ 0 is allowed (a thin rod)
+                return (
+                    f"{what} has {k} = {to_plain(entries[k])} = 0 there ({where}.{k}): the body "
+                    "has no inertia about that axis, the mass matrix is singular, and the "
+                    "motion near the point is not determined"
+                )
+        errors = _inertia_errors(where, what, here)  # not positive semidefinite, I₁ + I₂ < I₃
+        if errors:
+            return f"{errors[0]['message']} there ({errors[0]['field']})"
     return None
 
 

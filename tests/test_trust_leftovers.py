@@ -130,3 +130,123 @@ def test_a_force_at_rest_alone_does_no_work_there():
     conserved, text, kind = verdicts(force)
     assert conserved and "do no work" in text and "themselves are 0" not in text, text
     assert kind == "no sign"
+
+
+# --- 2. a mass or inertia that depends on the coordinates, not positive at an equilibrium -------
+
+
+def trap(mass: str, centre: float, initial: float = 0.0) -> dict:
+    """A particle of mass m (2 − x) in the trap k ((x − centre)² + y²)/2: the forces balance at
+    (centre, 0) alone, where the mass is m (2 − centre)."""
+    return {
+        "title": "Particle whose mass depends on x",
+        "coordinates": ["x", "y"],
+        "parameters": {"m": 1.0, "k": 1.0},
+        "initial": {"x": initial},
+        "bodies": [{"name": "p", "mass": mass, "position": ["x", "y", 0]}],
+        "potentials": [{"name": "trap", "expression": f"k*((x - {centre})**2 + y**2)/2"}],
+    }
+
+
+def wheel(izz: str, centre: float, extra: dict | None = None) -> dict:
+    """A wheel turned by θ about its fixed centre (z), with a torsion spring k (θ − centre)²/2."""
+    return {
+        "title": "Wheel whose moment depends on its angle",
+        "coordinates": ["theta"],
+        "parameters": {"m": 1.0, "k": 1.0, "I0": 1.0},
+        "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
+        "bodies": [
+            {
+                "name": "wheel",
+                "kind": "rigid_body",
+                "mass": "m",
+                "frame": "R",
+                "position": [0, 0, 0],
+                "inertia": {"ixx": "I0", "iyy": "I0", "izz": izz},
+                **(extra or {}),
+            }
+        ],
+        "potentials": [{"name": "spring", "expression": f"k*(theta - {centre})**2/2"}],
+    }
+
+
+def equilibria_of(spec: dict) -> dict:
+    from mechanics.equilibria import equilibria
+
+    return equilibria(derive_model(spec))
+
+
+@pytest.mark.parametrize(("centre", "mass_there"), [(3.0, -1.0), (2.0, 0.0)])
+def test_an_equilibrium_where_the_mass_is_not_positive_is_left_out_naming_the_field(
+    centre, mass_there
+):
+    """m (2 − x) at x = centre is 1·(2 − centre) ≤ 0: no body, so no equilibrium to linearize
+    (it was called "unstable, λ = 1" at x = 3, and "stable" with no inertia at x = 2). The note
+    names the field, and the forces are not said to "never balance"."""
+    out = equilibria_of(trap("m*(2 - x)", centre))
+    assert out["equilibria"] == []
+    note = next(w for w in out["warnings"] if "bodies[0].mass" in w)
+    assert f"x = {centre:g}" in note and f"is {mass_there:g} there" in note, note
+    assert not any("never balance" in w for w in out["warnings"]), out["warnings"]
+
+
+def test_a_negative_or_vanishing_moment_at_an_equilibrium_is_left_out_naming_the_field():
+    """izz = I0 (1 − θ): −1 at θ = 2 (no body has that) and 0 at θ = 1, where the wheel's only
+    inertia about its axis is gone (M = [izz] = 0): both left out, each naming the entry."""
+    for centre, value in ((2.0, "-1"), (1.0, "0")):
+        out = equilibria_of(wheel("I0*(1 - theta)", centre))
+        assert out["equilibria"] == [], out
+        note = next(w for w in out["warnings"] if "bodies[0].inertia.izz" in w)
+        assert f"= {value} there" in note, note
+
+
+def test_a_moment_that_is_positive_or_zero_beside_other_inertia_keeps_its_equilibrium():
+    """No false alarm. izz = I0 (1 − θ) at θ = 0.5 is 0.5: ω = √(k / izz) = √2. A rod pivoted at
+    its end (centre of mass l/2 below) with izz = m l² sin²θ/12, 0 at θ = 0 and π: the pivot's
+    moment m l²/4 remains, M is regular, and at the bottom ω = √(m g l/2 / (m l²/4)) = √(2g/l);
+    the top is kept too (unstable)."""
+    izz = "m*l**2*sin(theta)**2/12"
+    out = equilibria_of(wheel("I0*(1 - theta)", 0.5))
+    (e,) = out["equilibria"]
+    assert e["kind"] == "stable" and e["frequencies"] == pytest.approx([np.sqrt(2.0)])
+    rod = {
+        "title": "Rod whose central moment vanishes at the bottom",
+        "coordinates": ["theta"],
+        "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
+        "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
+        "bodies": [
+            {
+                "name": "rod",
+                "kind": "rigid_body",
+                "mass": "m",
+                "frame": "R",
+                "position": {"frame": "R", "components": [0, "-l/2", 0]},
+                "inertia": {"ixx": "m*l**2/12", "iyy": "m*l**2/12", "izz": izz},
+            }
+        ],
+        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    }
+    out = equilibria_of(rod)
+    bottom = next(e for e in out["equilibria"] if abs(e["q"]["theta"]) < 1e-9)
+    assert bottom["kind"] == "stable"
+    assert bottom["frequencies"] == pytest.approx([np.sqrt(2 * 9.81 / 1.0)])
+    assert any(e["kind"] == "unstable" and abs(e["q"]["theta"]) > 3 for e in out["equilibria"])
+    assert not any("inertia" in w for w in out["warnings"]), out["warnings"]
+
+
+def test_the_api_names_the_field_whether_the_request_or_an_equilibrium_is_unphysical():
+    """Through /api/v1/equilibria: a request whose own state has the mass −1 (x = 3) is a 422 in
+    the one error shape naming bodies[0].mass; one starting at x = 0 (mass 2) answers 200 and
+    leaves the point x = 3 out with the same field named."""
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    client = TestClient(app)
+    r = client.post("/api/v1/equilibria", json={"scene": trap("m*(2 - x)", 3.0, initial=3.0)})
+    assert r.status_code == 422, r.text
+    assert [e["field"] for e in r.json()["detail"]] == ["bodies[0].mass"], r.json()
+    r = client.post("/api/v1/equilibria", json={"scene": trap("m*(2 - x)", 3.0)})
+    assert r.status_code == 200, r.text
+    assert r.json()["equilibria"] == []
+    assert any("bodies[0].mass" in w for w in r.json()["warnings"]), r.json()["warnings"]
