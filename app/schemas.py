@@ -522,6 +522,11 @@ class ConstraintForceOut(BaseModel):
     """The force a constraint supplies to one body, with q̈ from the equations of motion."""
 
     body: str
+    name: str = Field(
+        description="As the free-body diagram names it: F_T (a rod's or rope's tension), F_N "
+        "(a normal force), F_pin (a pin reaction) when it is one force there, else F_C, the "
+        "resultant of the several the diagram draws."
+    )
     frame: str = Field(description="The frame its components are written in.")
     unit_vectors: list[str]
     components: list[str]
@@ -532,10 +537,34 @@ class ConstraintForceOut(BaseModel):
     tension: str | None = Field(description="The pull toward that point (negative: a push).")
 
 
+class DiagramForceOut(BaseModel):
+    """One force of the free-body diagram on one body, by the name the diagram gives it."""
+
+    body: str = Field(description="The body it acts on.")
+    name: str = Field(
+        description="F_g (weight), F_<spring> (a spring's pull), F_<name> or M_<name> (a "
+        "force, damper or torque of the scene, by its name), and for constraint forces F_T "
+        "(tension of a rod or rope), F_N (normal force), F_f (static friction), F_pin (pin "
+        "reaction) or F_C (a constraint force with no narrower name)."
+    )
+    kind: str = Field(
+        description="weight, spring, force, damper or torque (applied), or constraint."
+    )
+    latex: str = Field(description="Its label as the diagram and the steps typeset it.")
+    what: str | None = Field(
+        description="A constraint force in words, as the diagram says it (which rod pulls, "
+        "on what); null for an applied force."
+    )
+
+
 class NewtonResponse(BaseModel):
     """Σ F = m a (and Σ M = dH/dt) beside Lagrange: steps, constraint forces, agreement."""
 
     steps: list[Step]
     constraint_forces: list[ConstraintForceOut]
+    forces: list[DiagramForceOut] = Field(
+        description="Every force the free-body diagram draws, body by body (a scene "
+        "potential's force enters through V and is not drawn)."
+    )
     equations: dict[str, str] = Field(description="Newton's equations projected on each δq_j.")
     agrees_with_lagrange: bool

@@ -12,6 +12,7 @@ a scene's parameter (R is a radius) nor the kinetic energy T.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -202,6 +203,49 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
     ]
 
 
+#: A free-body diagram's label of an applied force: \vec{F}_{g,\text{bob}}, \vec{M}_{\text{motor}}.
+_LABEL = re.compile(r"\\vec\{(?P<letter>\w+)\}_\{(?P<index>.*)\}")
+_TEXT = re.compile(r"\\text\{(.*)\}")  # `sub` of a word
+
+
+def _applied_name(label: str, body: str) -> str:
+    """F_g, F_spring, M_motor: the label's letter and subscript without the body's name, in the
+    form the constraint forces' names take (F_T, F_N), so that a client needs no LaTeX parser."""
+    match = _LABEL.fullmatch(label)
+    if match is None:
+        return label
+    index = match["index"].removesuffix("," + sub(body))
+    word = _TEXT.fullmatch(index)
+    return f"{match['letter']}_{word[1] if word else index}"
+
+
+def diagram_forces(d: Derivation) -> list[dict[str, str | None]]:
+    """Every force the free-body diagram draws, by body: its name, kind and label there.
+
+    Read from the diagram step's own data, so that /newton and the diagram cannot disagree on a
+    name. A scene potential's −∇V is not drawn (it enters through V), so it is not listed."""
+    fbd = next(s for s in d.steps if s.id == "fbd")
+    out = []
+    for drawn in fbd.data["bodies"]:
+        body = drawn["body"]
+        for f in drawn["forces"]:
+            name = _applied_name(f["label"], body)
+            out.append(
+                {"body": body, "name": name, "kind": f["kind"], "latex": f["label"], "what": None}
+            )
+        for f in drawn["constraint_forces"]:
+            out.append(
+                {
+                    "body": body,
+                    "name": f["name"],
+                    "kind": "constraint",
+                    "latex": f["label"],
+                    "what": f["what"],
+                }
+            )
+    return out
+
+
 def newton_json(d: Derivation) -> dict[str, Any]:
     """What /api/v1/newton returns: steps, constraint forces, and the agreement with Lagrange."""
     m = d.model
@@ -214,6 +258,7 @@ def newton_json(d: Derivation) -> dict[str, Any]:
         "constraint_forces": [
             {
                 "body": f.body,
+                "name": f.name,
                 "frame": f.frame,
                 "unit_vectors": list(names(f.frame)),
                 "components": [to_plain(c) for c in f.components],
@@ -223,6 +268,7 @@ def newton_json(d: Derivation) -> dict[str, Any]:
             }
             for f in forces
         ],
+        "forces": diagram_forces(d),
         "equations": {
             name: f"{to_plain(r)} = 0" for name, r in zip(m.coordinate_names, residual, strict=True)
         },

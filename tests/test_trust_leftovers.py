@@ -250,3 +250,90 @@ def test_the_api_names_the_field_whether_the_request_or_an_equilibrium_is_unphys
     assert r.status_code == 200, r.text
     assert r.json()["equilibria"] == []
     assert any("bodies[0].mass" in w for w in r.json()["warnings"]), r.json()["warnings"]
+
+
+# --- 3. /api/v1/newton names its forces as the free-body diagram does -------------------------
+
+
+@pytest.fixture(scope="module")
+def client():
+    from fastapi.testclient import TestClient
+
+    from app.main import app
+
+    return TestClient(app)
+
+
+def scene_ids_of_catalog() -> list[str]:
+    from mechanics.scenes import scene_ids
+
+    return list(scene_ids())
+
+
+@pytest.mark.parametrize("scene_id", scene_ids_of_catalog())
+def test_newton_names_each_force_as_the_free_body_diagram_of_the_same_scene(client, scene_id):
+    """Body by body, /newton's ``forces`` are the diagram's (its ``fbd`` step from /derive): the
+    same labels and kinds in the same order, constraint forces under the diagram's names; an
+    applied force is F_g for a weight and F_<name> / M_<name> by the spec's own name of the spring,
+    damper, force or torque (read from the spec, not from a label). The fields that were there
+    stay (additive only)."""
+    newton = client.post("/api/v1/newton", json={"scene_id": scene_id})
+    derive = client.post("/api/v1/derive", json={"scene_id": scene_id})
+    assert newton.status_code == derive.status_code == 200
+    out = newton.json()
+    assert {"steps", "constraint_forces", "equations", "agrees_with_lagrange"} <= set(out)
+    fbd = next(s for s in derive.json()["steps"] if s["id"] == "fbd")["data"]["bodies"]
+    spec = client.get(f"/api/v1/scenes/{scene_id}").json()["spec"]
+    named = {s["name"] for s in spec.get("springs", [])} | {
+        x["name"] for group in ("forces", "torques", "dampers") for x in spec.get(group, [])
+    }
+    expected = []
+    for drawn in fbd:
+        for f in drawn["forces"]:
+            expected.append((drawn["body"], f["label"], f["kind"]))
+        for f in drawn["constraint_forces"]:
+            expected.append((drawn["body"], f["label"], "constraint"))
+    assert [(f["body"], f["latex"], f["kind"]) for f in out["forces"]] == expected
+    constraint = [(d["body"], f["name"], f["what"]) for d in fbd for f in d["constraint_forces"]]
+    got = [(f["body"], f["name"], f["what"]) for f in out["forces"] if f["kind"] == "constraint"]
+    assert got == constraint
+    for f in out["forces"]:
+        if f["kind"] == "weight":
+            assert f["name"] == "F_g"
+        elif f["kind"] != "constraint":
+            letter, _, name = f["name"].partition("_")
+            assert name in named and letter == ("M" if f["kind"] == "torque" else "F"), f
+            assert f["what"] is None
+
+
+@pytest.mark.parametrize(
+    ("scene_id", "names"),
+    [
+        ("simple_pendulum", {"bob": "F_T"}),  # the rod's tension
+        ("bead_on_hoop", {"bead": "F_N"}),  # the hoop's normal force
+        ("atwood_machine", {"mass1": "F_T", "mass2": "F_T"}),  # the string's tension
+        ("rolling_disk", {"disk": "F_C"}),  # normal force and static friction together
+    ],
+)
+def test_each_constraint_force_carries_its_name(client, scene_id, names):
+    """A tension is F_T, a hoop's push F_N; the rolling disk's ground exerts F_N and F_f, whose
+    sum m a − ΣF is the resultant F_C (and the diagram draws the two)."""
+    out = client.post("/api/v1/newton", json={"scene_id": scene_id}).json()
+    assert {f["body"]: f["name"] for f in out["constraint_forces"]} == names
+    if scene_id == "rolling_disk":
+        drawn = {f["name"] for f in out["forces"] if f["kind"] == "constraint"}
+        assert drawn == {"F_N", "F_f"}
+
+
+def test_the_openapi_schema_documents_the_force_names(client):
+    """The new fields are in the OpenAPI document, each described, beside the old ones."""
+    schemas = client.get("/openapi.json").json()["components"]["schemas"]
+    newton = schemas["NewtonResponse"]
+    assert {"steps", "constraint_forces", "equations", "agrees_with_lagrange", "forces"} <= set(
+        newton["properties"]
+    )
+    assert newton["properties"]["forces"]["items"]["$ref"].endswith("/DiagramForceOut")
+    force = schemas["DiagramForceOut"]["properties"]
+    assert all(force[k].get("description") for k in ("body", "name", "kind", "latex", "what"))
+    assert "F_T" in force["name"]["description"]
+    assert schemas["ConstraintForceOut"]["properties"]["name"].get("description")
