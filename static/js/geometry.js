@@ -8,6 +8,7 @@ import { compile } from "./expr.js";
 export const COLORS = ["#1f6feb", "#d9480f", "#2f9e44", "#9c36b5", "#e8590c", "#0c8599"];
 const REL = 1e-6; // relative tolerance for "constant" along a run
 const SWEEP = 121; // points along a swept wire
+const DOWN = [0, -1, 0]; // gravity's direction when a spec gives none (spec.py Gravity.direction)
 // spec -> {q: [lo, hi]}: the range each coordinate covered in the last full run, so a one-sample
 // run (an equilibrium sketch) of the same spec sweeps its wire over the same stretch.
 const lastRanges = new WeakMap();
@@ -98,7 +99,9 @@ export class SceneGeometry {
     this.bodies = spec.bodies.filter((b) => this.P[b.name]);
     this.parameters = parameters;
     this.coordinates = new Set(spec.coordinates || []);
-    const g = spec.gravity ? [...spec.gravity.direction, 0].slice(0, 3) : null;
+    // a valid spec may leave out the direction (the schema's default: down -y); the page must
+    // read it as the server does, not fail on it
+    const g = spec.gravity ? [...(spec.gravity.direction ?? DOWN), 0].slice(0, 3) : null;
     this.down = g ? unit(g) : [0, -1, 0];
     this.hasGravity = Boolean(g);
     this.is3D = this.bodies.some((b) => this.P[b.name].z.some((z) => Math.abs(z) > 1e-9));
@@ -365,7 +368,8 @@ export class SceneGeometry {
           return;
         }
         const spec = (this.spec.frames || []).find((f) => f.name === frame);
-        const axisIndex = spec && spec.parent === "N" ? "xyz".indexOf(spec.axis) : -1;
+        // (a frame that names no parent turns in N: the schema's default)
+        const axisIndex = spec && (spec.parent ?? "N") === "N" ? "xyz".indexOf(spec.axis) : -1;
         const radial = rel.every((r) => norm(cross(unit(r), unit(rel[rel.length - 1]))) <= 1e-6);
         if (!constant && !still && axisIndex >= 0 && radial) {
           const r = rel[rel.length - 1];
