@@ -2,7 +2,7 @@
 // in the URL query (?m=1.2&theta=0.5&method=rk4&dt=0.01), so a link reproduces a run exactly.
 
 import { nameText } from "./texnames.js";
-const SETTINGS = ["method", "method_b", "tol", "dt", "t_end", "compare", "lecture", "phase"];
+const SETTINGS = ["method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture", "phase"];
 
 /** A sensible slider range for a value: [0, 3x] for a positive parameter, ±π for an angle. */
 export function sliderRange(value, { angle = false, positive = false } = {}) {
@@ -32,20 +32,29 @@ export function readValues(spec, query) {
   return { params, initial };
 }
 
-/** The state as a query string: parameters, initial state, integrator settings. */
+/** The state as a query string: parameters, initial state, integrator settings (with a link's
+ * own atol, integrator.js readSettings), and the editor's share token: the token is the spec a
+ * reload of /editor restores, so every rewrite of the address keeps it (editor.js drops it when
+ * another spec is derived). */
 export function writeQuery({ params, initial, settings, fixed, lecture }) {
   const q = new URLSearchParams();
   for (const [k, v] of Object.entries(params)) q.set(k, String(v));
   for (const [k, v] of Object.entries(initial)) q.set(k, String(v));
   q.set("method", settings.method);
   if (fixed(settings.method) || (settings.compare && fixed(settings.methodB))) q.set("dt", settings.dt);
-  if (!fixed(settings.method) || (settings.compare && !fixed(settings.methodB))) q.set("tol", settings.tol);
+  if (!fixed(settings.method) || (settings.compare && !fixed(settings.methodB))) {
+    q.set("tol", settings.tol);
+    if (settings.atol) q.set("atol", settings.atol);
+  }
   q.set("t_end", String(settings.t_end));
   if (settings.compare) {
     q.set("compare", "1");
     q.set("method_b", settings.methodB);
   }
   if (lecture) q.set("lecture", "1");
+  const here = typeof location === "undefined" ? "" : location.search; // (none in node)
+  const token = new URLSearchParams(here).get("share");
+  if (token) q.set("share", token);
   return q.toString();
 }
 

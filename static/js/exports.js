@@ -21,7 +21,8 @@ function runBody(source, state) {
     parameters: state.parameters || {},
     initial: state.initial || {},
     method: s.method || "dop853_c",
-    ...(fixed ? { dt: Number(s.dt) } : { rtol: Number(s.tol), atol: Number(s.tol) }),
+    // a link's own atol (integrator.js readSettings) stays what it was, else atol = rtol
+    ...(fixed ? { dt: Number(s.dt) } : { rtol: Number(s.tol), atol: Number(s.atol || s.tol) }),
     t_end: Number(s.t_end) || 10,
   };
 }

@@ -22,11 +22,22 @@ function choose(select, value) {
   select.value = value;
 }
 
+/** A link's own absolute tolerance (`atol`, a share link's when it differs from rtol), or null
+ * when the panel's one tolerance is both: the panel has no atol control, so it is kept as the link
+ * gave it, for the runs, the address and the exports, until a tolerance is picked. */
+function linkAtol(query, tol) {
+  const raw = query.get("atol");
+  const x = Number(raw);
+  return raw && Number.isFinite(x) && x > 0 && x !== Number(tol) ? raw : null;
+}
+
 export function readSettings(query) {
+  const tol = query.get("tol") || "1e-9";
   return {
     method: query.get("method") || "dop853_c",
     methodB: query.get("method_b") || "rk4",
-    tol: query.get("tol") || "1e-9",
+    tol,
+    atol: linkAtol(query, tol),
     dt: query.get("dt") || "0.01",
     t_end: Math.min(120, Math.max(0.1, Number(query.get("t_end")) || 10)),
     compare: query.get("compare") === "1",
@@ -59,9 +70,26 @@ export function mountIntegrator(settings, onChange) {
     document.querySelector(".stage-views").classList.toggle("two", settings.compare);
   };
   sync();
+  showAtol(settings);
+  $("tol").addEventListener("change", () => { settings.atol = null; showAtol(settings); });
   for (const id of ["method", "method-b", "tol", "dt", "t_end", "compare"]) {
     $(id).addEventListener("change", () => { sync(); onChange(); });
   }
+}
+
+/** The tolerance label says what the runs use: "rtol = atol", or rtol here and the link's atol
+ * beside it (picking a tolerance makes it both again). */
+function showAtol(settings) {
+  const box = $("tol-box");
+  const words = [...box.childNodes].find((n) => n.nodeType === Node.TEXT_NODE && n.textContent.trim());
+  if (words) words.textContent = settings.atol ? "tolerance rtol " : "tolerance rtol = atol ";
+  let note = $("atol-note");
+  if (!settings.atol) return note?.remove();
+  if (!note) {
+    note = Object.assign(document.createElement("span"), { id: "atol-note", className: "muted" });
+    box.append(note);
+  }
+  note.textContent = ` atol = ${settings.atol} (from the link)`;
 }
 
 export function fmt(x, digits = 4) {
