@@ -10,6 +10,7 @@ const LINE = 20; // px, as in app.css (.code textarea line-height)
 let view = null;
 let marks = [];
 let shared = null; // the spec a share link brought, reloadable from the "Start from" list
+let sharedToken = null; // its token, kept in the address while that spec is the one derived
 
 export async function mountEditor() {
   const query = new URLSearchParams(location.search);
@@ -35,7 +36,10 @@ export async function mountEditor() {
 
 /** A share link of one's own spec (/s/{token} lands here with ?share=token): the spec in the
  * editor, the page's state (values, integrator, lecture step) in the query the scene view reads,
- * then derived and run as the sharer saw it. False (with the reason shown) if the link is bad. */
+ * then derived and run as the sharer saw it. The token stays in the address, so a reload (or the
+ * address copied) brings back this spec, not a template; an address that already holds a state
+ * beside the token is the page's own after a reload (values moved since), and is kept. False
+ * (with the reason shown) if the link is bad. */
 async function openShared(token) {
   let state;
   try {
@@ -45,22 +49,34 @@ async function openShared(token) {
     return false;
   }
   if (!state.scene) return false;
+  sharedToken = token;
+  // (the page writes `method` into every address it keeps: then this is a reload)
+  if (!new URLSearchParams(location.search).has("method")) {
+    history.replaceState(null, "", `${location.pathname}?${sharedQuery(state, token)}`);
+  }
+  shared = state.scene;
+  showSpec(shared);
+  await Promise.all([derive(), showOrigin(shared)]);
+  return true;
+}
+
+/** The query the scene view reads for a shared state (controls.js writeQuery's keys), with the
+ * token. */
+function sharedQuery(state, token) {
   const q = new URLSearchParams();
   for (const [k, v] of Object.entries({ ...state.parameters, ...state.initial })) q.set(k, String(v));
   q.set("method", state.method || "dop853_c");
   if (state.dt != null) q.set("dt", String(state.dt));
   if (state.rtol != null) q.set("tol", String(state.rtol));
+  if (state.atol != null && state.atol !== state.rtol) q.set("atol", String(state.atol));
   if (state.t_end != null) q.set("t_end", String(state.t_end));
   if (state.compare) q.set("compare", "1");
   if (state.method_b) q.set("method_b", state.method_b);
   if (state.lecture) q.set("lecture", "1");
   if (state.lecture_step != null) q.set("step", String(state.lecture_step));
   if (state.phase) q.set("phase", state.phase);
-  history.replaceState(null, "", `${location.pathname}?${q}`);
-  shared = state.scene;
-  showSpec(shared);
-  await Promise.all([derive(), showOrigin(shared)]);
-  return true;
+  q.set("share", token);
+  return q;
 }
 
 const SHARED = ""; // the value of the "shared spec" entry of the "Start from" list
@@ -224,8 +240,19 @@ async function derive() {
     $("derive").disabled = false;
   }
   showErrors([]);
+  keepToken(spec);
   $("editor-status").textContent = `derived in ${(derivation.seconds ?? 0).toFixed(2)} s`;
   $("result").hidden = false;
   if (view) await view.load(spec, new URLSearchParams(), derivation);
   else view = await mountScene({ spec, derivation });
+}
+
+/** The share token stays in the address while the shared spec is the one derived (a reload
+ * restores it); another spec derived drops it, and a reload brings back the template. */
+function keepToken(spec) {
+  if (!sharedToken) return;
+  const q = new URLSearchParams(location.search);
+  if (JSON.stringify(spec) === JSON.stringify(shared)) q.set("share", sharedToken);
+  else q.delete("share");
+  history.replaceState(null, "", `${location.pathname}?${q}${location.hash}`);
 }
