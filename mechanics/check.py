@@ -11,6 +11,7 @@ parameters swapped, q mixed up with q̇) and the units of every term are checked
 from __future__ import annotations
 
 import cmath
+import itertools
 import math
 import random
 import re
@@ -60,6 +61,12 @@ NEAR_MISS = 1e-6
 #: MAX_TRIG_MULTIPLE): sin(10¹⁴ θ) expanded would never finish.
 MAX_CANONICAL_MULTIPLE = 64
 NEAR_MISS_DENOMINATOR = 1000
+#: A group of terms is restated in the student's own terms only if changing at most this many
+#: of them (trying at most MAX_CHANGE_TRIES sets) says what differs.
+MAX_CHANGED_TERMS = 3
+MAX_CHANGE_TRIES = 64
+#: F of a total derivative dF/dt is integrated only from polynomials up to this degree.
+MAX_INTEGRATED_POWER = 8
 
 
 def _never_zero(factor: sp.Expr) -> bool:
@@ -628,11 +635,65 @@ class _Judge:
             return
         if q == "L" and self._time_only(self.given - self.expected, fb):
             return
+        if q == "L" and self._total_derivative(self.given - self.expected, fb):
+            return
         if q == "Q" and self._conservative_part(fb):
             return
         if q in ("V", "L") and self._shifted_datum(fb):
             return
+        if q == "accel" and self._unsolved(fb):
+            return
         self._diagnose(self.given, self.expected, fb)
+
+    def _unsolved(self, fb: list[str]) -> bool:
+        """A q̈_j that still holds an acceleration (ẍ in θ̈ = −(g sin θ + cos θ ẍ)/l): an equation
+        of motion rearranged, not yet solved for the accelerations, which are found together.
+        Compared term by term with the derived q̈_j, its terms read as 'extra', right or wrong
+        alike; read as the equation q̈_j = answer, it is judged as one: right but unsolved, or
+        wrong where the equation is (a sign error named as such)."""
+        m, j = self.m, self.j
+        inside = [a for a in m.qdd if self.given.has(a)]
+        if not inside:
+            return False
+        own = m.qdd[j]
+        others = [a for a in inside if a != own]
+        named = " and ".join(inline(a) for a in others)
+        equation = f"${to_latex(own)} = {to_latex(self.given)}$"
+        sources = " and ".join(inline(q) for q, a in zip(m.q, m.qdd, strict=True) if a in others)
+        if others:
+            why = (
+                f"Your {inline(own)} still contains {named}, which is itself unknown: the "
+                "accelerations are coupled, and are found only by solving the equations of "
+                f"motion of all the coordinates together. Eliminate {named} with "
+                f"the equation{'s' * (len(others) > 1)} of motion for {sources}, so that the "
+                "answer depends only on the coordinates, their rates and t."
+            )
+        else:
+            why = (
+                f"Your {inline(own)} contains {inline(own)} itself: solve the equation for it, "
+                "so that the answer depends only on the coordinates, their rates and t."
+            )
+        solved = dict(zip(m.qdd, self.d.solved_accelerations, strict=True))
+        reading = own - self.given
+        if zero_proof(reading, m) is True:
+            fb.append(f"{why} As an equation, {equation} is 0 = 0: it determines nothing.")
+            return True
+        if zero_proof(reading.xreplace(solved), m) is True:
+            fb.append(
+                f"{why} As an equation, {equation} is right: it holds along the motion (the "
+                "equations of motion rearranged), but it is not yet solved."
+            )
+            return True
+        judge = _Judge(self.d, "eom", j, expected_quantity(self.d, "eom", j), reading)
+        verdict = Verdict(False)
+        judge.run(verdict)
+        lines = [line for line in verdict.feedback if not line.startswith("Correct")]
+        if not verdict.confirmed or verdict.correct or not lines:
+            fb.append(why)  # nothing certain to add about the equation itself
+            return True
+        fb.append(f"{why} Read as the equation {equation}, it is not right either:")
+        fb += lines
+        return True
 
     def _conservative_part(self, fb: list[str]) -> bool:
         """A Q_j that is Q_j^NC plus −∂V/∂q_j: the notes' eq. 31 sums every force, gravity and
@@ -757,6 +818,66 @@ class _Judge:
             "is T − V itself, and that term belongs in it."
         )
         return True
+
+    def _total_derivative(self, diff: sp.Expr, fb: list[str]) -> bool:
+        """An L that differs from T − V by a total time derivative dF/dt of some F(q, t) (the
+        rotating frame's m Ω (z ẋ + x ż) = d/dt(m Ω x z)): it gives the same equations of motion,
+        yet it is not T − V as asked; blaming its terms one by one would hide that. Proved: the
+        Euler–Lagrange expression d/dt ∂/∂q̇_j − ∂/∂q_j of the difference is zero for every j
+        (the difference is then linear in q̇, the gradient of its F). F is named when sympy
+        finds it quickly, and is checked by differentiating it back."""
+        m = self.m
+        if diff.has(*m.qdd) or sp.count_ops(diff) > PROOF_OPS:
+            return False
+        if _expansion_size(diff, MAX_NORMAL_TERMS) > MAX_NORMAL_TERMS:
+            return False
+        for q, qd in zip(m.q, m.qd, strict=True):
+            euler_lagrange = partial(diff, qd, m).diff(t) - partial(diff, q, m)
+            if zero_proof(euler_lagrange, m) is not True:
+                return False
+        potential = self._potential_of(diff)
+        named = (
+            f", $\\frac{{d}}{{dt}}\\left({to_latex(potential)}\\right)$,"
+            if potential is not None and sp.count_ops(potential) <= 30
+            else " dF/dt of a function F(q, t),"
+        )
+        fb.append(
+            f"Your L differs from T − V by a total time derivative{named} so it gives the same "
+            "equations of motion (adding such a term to L changes none of them); but the L "
+            "asked for here is T − V itself, without it."
+        )
+        return True
+
+    def _potential_of(self, diff: sp.Expr) -> sp.Expr | None:
+        """F(q, t) with dF/dt = ``diff`` (already shown to be a total derivative), integrated
+        one variable at a time when the pieces are polynomials of low degree in q, t, sin q and
+        cos q (where integration is quick); None otherwise, or if dF/dt does not give it back."""
+        m = self.m
+        to_sym, back = _symbols_for(m)
+        plain = sp.expand(diff.xreplace(to_sym))
+        if _max_power(plain) > MAX_INTEGRATED_POWER or plain.has(sp.Abs, sp.sign, sp.exp):
+            return None
+        q = [to_sym[x] for x in m.q]
+        qd = [to_sym[x] for x in m.qd]
+        rates = [plain.diff(v) for v in qd]
+        rest = sp.expand(plain - sum(r * v for r, v in zip(rates, qd, strict=True)))
+        potential = sp.S.Zero
+        for x, rate in [*zip(q, rates, strict=True), (t, rest)]:
+            piece = sp.expand(rate - potential.diff(x))
+            if piece == 0:
+                continue
+            params = set(m.params.values())
+            if any(a.args[0].free_symbols - {*q, t, *params} for a in piece.atoms(sp.sin, sp.cos)):
+                return None
+            if not piece.is_polynomial(*q, t, *piece.atoms(sp.sin, sp.cos)):
+                return None
+            potential += sp.integrate(piece, x)
+        if potential.has(sp.Integral):
+            return None
+        potential = _tidy(potential.xreplace(back), m)
+        if zero_proof(potential.diff(t) - diff, m) is not True:
+            return None
+        return potential
 
     def _settle(self, verdict: Verdict, diff: sp.Expr, constant: bool = False) -> None:
         """The samples found no difference (or a constant one): "Correct" only on a proof.
@@ -1447,18 +1568,65 @@ class _Judge:
             return []
         if all(len(self._canonical(k)) <= 1 for k in (*g, *e)):
             return []  # nothing was rewritten: the pieces are the terms
-        fb = []
-        for k in [k for k in e if k in g and sp.simplify(g[k] - e[k]) != 0]:
-            fb.append(self._one_for_one(g[k] * k, e[k] * k))
-        extra = [c * k for k, c in g.items() if k not in e]
-        missing = [c * k for k, c in e.items() if k not in g]
-        if extra and missing and self.same(sp.Add(*extra), sp.Add(*missing)):
-            return fb  # written otherwise (1 − cos²θ for sin²θ), not wrong
+        change = self._smallest_change(g, e)
+        if change is None:
+            return []  # no short story in the student's terms: the canonical pieces tell it
+        fb, extra, missing = [], [], []
+        for k, c in change.items():
+            mine = g.get(k, sp.S.Zero)
+            right = sp.simplify(mine - c)
+            if mine == 0:
+                missing.append(right * k)
+            elif right == 0:
+                extra.append(mine * k)
+            else:
+                fb.append(self._one_for_one(mine * k, right * k))
         if len(extra) == 1 and len(missing) == 1:
             return [*fb, self._one_for_one(extra[0], missing[0])]
         fb += [f"Extra term {self._show(w)}: the correct answer has none like it." for w in extra]
         fb += [f"Missing term {self._show(x)}{self._source(velocity)}." for x in missing]
         return fb
+
+    def _smallest_change(
+        self, g: dict[sp.Expr, sp.Expr], e: dict[sp.Expr, sp.Expr]
+    ) -> dict[sp.Expr, sp.Expr] | None:
+        """The fewest of the student's terms (then of the derived result's) whose coefficients,
+        changed, turn the student's group into the derived one: {term: how much too much}.
+
+        The difference is taken in the canonical form, where equal terms cancel however each
+        side wrote them (I₃ cos²θ φ̇²/2 is I₃ φ̇²/2 − I₃ sin²θ φ̇²/2 in the derived T of a top), so
+        a term that is right is never named; only then is it said in the student's own terms.
+        {} when nothing differs; None when no few terms carry the difference."""
+        difference = self._canonical(
+            sp.Add(*(c * k for k, c in g.items())) - sp.Add(*(c * k for k, c in e.items()))
+        )
+        if not difference:
+            return {}
+        candidates = [*g, *(k for k in e if k not in g)]  # the student's terms first
+        columns = [self._canonical(k) for k in candidates]
+        rows = set(difference).union(*columns)
+        tried = 0
+        for size in range(1, min(len(candidates), MAX_CHANGED_TERMS) + 1):
+            for chosen in itertools.combinations(range(len(candidates)), size):
+                tried += 1
+                if tried > MAX_CHANGE_TRIES:
+                    return None
+                unknowns = [sp.Dummy(f"c{i}") for i in chosen]
+                equations = [
+                    sp.Add(
+                        *(u * columns[i].get(r, 0) for u, i in zip(unknowns, chosen, strict=True))
+                    )
+                    - difference.get(r, 0)
+                    for r in rows
+                ]
+                solutions = sp.linsolve(equations, unknowns)
+                if not isinstance(solutions, sp.FiniteSet) or len(solutions) != 1:
+                    continue
+                (values,) = solutions
+                if any(v.free_symbols & set(unknowns) or sp.simplify(v) == 0 for v in values):
+                    continue  # not one way to say it, or a term that needs no change
+                return {candidates[i]: sp.simplify(v) for i, v in zip(chosen, values, strict=True)}
+        return None
 
     def _one_for_one(self, mine: sp.Expr, theirs: sp.Expr) -> str:
         """One term of the student's against the one the derivation has in its place."""
