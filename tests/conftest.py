@@ -1,4 +1,5 @@
-"""Shared test setup: the tests never read or write the user's own derivation cache."""
+"""Shared test setup: the tests never read or write the user's own derivation cache, and the tests
+that time themselves run last and alone when the suite is spread over workers (`-n 2`)."""
 
 from __future__ import annotations
 
@@ -26,3 +27,94 @@ def pytest_unconfigure(config: pytest.Config) -> None:
         os.environ.pop("LAGRANGE_LAB_CACHE", None)
     else:
         os.environ["LAGRANGE_LAB_CACHE"] = _saved["LAGRANGE_LAB_CACHE"]
+
+
+#: Tests that hold a wall clock to a bound tight enough (a second or a few) that a second worker
+#: running beside them on a 2-core machine could break it: a false alarm, not a slow server. They
+#: are marked `serial`; under pytest-xdist they run after every other test, on one worker, with
+#: the other one stopped. Named by node id (prefix), so the scheduler in the controller, which
+#: collects nothing, knows them too.
+SERIAL = (
+    "tests/test_simulate_fairness.py::test_a_flood_from_one_client_neither_fails_nor_delays",
+    "tests/test_budget.py::test_runaway_work_is_stopped_at_the_time_budget",
+    "tests/test_budget.py::test_one_clients_queue_does_not_delay_another_client",
+    "tests/test_pool.py::test_one_clients_heavy_requests_do_not_delay_another_client",
+    "tests/test_pool.py::test_hostile_answers_are_refused_within_the_budget",
+    "tests/test_fixed_step.py::test_a_finite_time_blow_up_is_told_as_one",
+    "tests/test_api.py::test_a_100_kb_expression_is_refused_fast",
+    "tests/test_integrators.py::test_stiff_linear_problem_is_solved_quickly",
+    "tests/test_check_trust.py::test_an_undecidable_hostile_answer_is_refused_a_proof_quickly",
+    "tests/browser/test_live.py::test_a_drag_keeps_sixty_frames_a_second",
+    "tests/browser/test_live.py::test_a_slider_input_is_drawn_within_a_few_frames",
+    "tests/browser/test_drag3d.py::test_a_3d_drag_keeps_sixty_frames_a_second",
+)
+
+
+def is_serial(nodeid: str) -> bool:
+    return nodeid.startswith(SERIAL)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        if is_serial(item.nodeid):
+            item.add_marker(pytest.mark.serial)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log):  # noqa: ANN201 (xdist's types)
+    """xdist's `load` scheduling, the `serial` tests held back to the end (see `SERIAL`)."""
+    if config.getvalue("dist") != "load":
+        return None
+    from xdist.scheduler import LoadScheduling
+
+    class SerialLast(LoadScheduling):
+        """Every other test is shared out as usual; the first worker to run dry is shut down, and
+        the last one, once it is alone, gets the held tests."""
+
+        held: list[int] = []  # noqa: RUF012 (replaced per instance in schedule)
+
+        def schedule(self) -> None:
+            if self.collection is not None or not self._check_nodes_have_same_collection():
+                return super().schedule()  # a later call, or xdist's own refusal to go on
+            self.collection = next(iter(self.node2collection.values()))
+            self.held = [i for i, nodeid in enumerate(self.collection) if is_serial(nodeid)]
+            held = set(self.held)
+            self.pending[:] = [i for i in range(len(self.collection)) if i not in held]
+            if self.maxschedchunk is None:
+                self.maxschedchunk = len(self.collection)
+            # as xdist's first share: a quarter of each worker's part, in collection order
+            chunk = max(2, min(len(self.pending) // len(self.nodes) // 4, self.maxschedchunk))
+            for node in self.nodes:
+                self._send_tests(node, chunk)
+            for node in self.nodes:
+                self.check_schedule(node)
+            return None
+
+        @property
+        def tests_finished(self) -> bool:
+            return not self.held and super().tests_finished
+
+        def check_schedule(self, node, duration: float = 0) -> None:
+            if node.shutting_down or self.pending or not self.held:
+                return super().check_schedule(node, duration)
+            if len(self.node2pending[node]) >= 2:
+                return None  # still busy with its share
+            others = [n for n in self.nodes if n is not node]
+            if any(not n.shutting_down for n in others):
+                node.shutdown()  # another worker is still running: that one will be the last
+                return None
+            if others:
+                return None  # the others are finishing their last test; remove_node calls back
+            self.pending[:], self.held = self.held, []
+            self._send_tests(node, len(self.pending))
+            node.shutdown()
+            return None
+
+        def remove_node(self, node):
+            crashed = super().remove_node(node)
+            if self.held:
+                for other in self.nodes:
+                    self.check_schedule(other)
+            return crashed
+
+    return SerialLast(config, log)
