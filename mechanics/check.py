@@ -678,6 +678,9 @@ class _Judge:
         if zero_proof(reading, m) is True:
             fb.append(f"{why} As an equation, {equation} is 0 = 0: it determines nothing.")
             return True
+        if not reading.has(own):  # θ̈ = θ̈ + 1: its own acceleration cancels, no equation for it
+            fb.append(why)
+            return True
         if zero_proof(reading.xreplace(solved), m) is True:
             fb.append(
                 f"{why} As an equation, {equation} is right: it holds along the motion (the "

@@ -250,3 +250,12 @@ def test_not_a_total_derivative_keeps_its_term_by_term_feedback(added):
     assert _euler_lagrange(extra, [_x, _z]) != [0, 0]  # it changes the equations: not a gauge
     lines, text = wrong("well", "L", WELL_L + added)
     assert "total time derivative" not in text, lines
+
+
+@pytest.mark.parametrize("answer", ["theta''", "theta'' + g/l"])
+def test_an_acceleration_written_with_itself_is_told_to_solve_for_it(answer):
+    lines, text = wrong("cart", "accel", answer, "theta")
+    assert "itself" in text and "Eliminate" not in text, lines
+    # θ̈ = θ̈ says 0 = 0; θ̈ = θ̈ + g/l has no θ̈ left to read as an equation of motion
+    assert ("0 = 0" in text) == (answer == "theta''"), lines
+    assert "Missing term" not in text and len(lines) == 1, lines
