@@ -4,6 +4,8 @@
   no framing, no referrer, on every response, errors included; and the server's time to the
   answer's first byte as ``Server-Timing: app``.
 - ``HeadAsGet``: ``HEAD`` answers what ``GET`` would, without the body (RFC 9110 §9.3.2).
+- ``OneValuePerKey``: an API query string that gives a key twice is refused with 422 naming the
+  key, before any route reads it (a route's ``Query`` would take the last value silently).
 - ``BodyLimit``: a body past the limit is refused with 413 as it streams in, whether it announced
   its length or came chunked; it is never read into memory whole.
 """
@@ -12,6 +14,8 @@ from __future__ import annotations
 
 import secrets
 import time
+from collections import Counter
+from urllib.parse import parse_qsl
 
 from starlette.datastructures import Headers, MutableHeaders
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
@@ -88,6 +92,31 @@ class HeadAsGet:
             await send(message)
 
         await self.app({**scope, "method": "GET"}, receive, send_headers_only)
+
+
+class OneValuePerKey:
+    """Refuses an ``/api/`` request whose query string gives a key more than once, with 422 in
+    the one error shape naming each such key (hostile play-test: ``?format=csv&format=json``
+    exported JSON where the GET exports refused it). The query is split as Starlette splits it
+    for the routes (app/routes/export.py reads ``request.query_params``). Pages are left alone:
+    their scripts read their own query, and an HTML page is no place for a JSON error."""
+
+    def __init__(self, app: ASGIApp, prefix: str = "/api/") -> None:
+        self.app = app
+        self.prefix = prefix
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http" and scope["path"].startswith(self.prefix):
+            query = scope.get("query_string", b"").decode("latin-1")
+            counts = Counter(key for key, _ in parse_qsl(query, keep_blank_values=True))
+            twice = [(key, n) for key, n in counts.items() if n > 1]
+            if twice:
+                detail = [
+                    {"field": k, "message": f"given {n} times: give it once"} for k, n in twice
+                ]
+                await ORJSONResponse({"detail": detail}, status_code=422)(scope, receive, send)
+                return
+        await self.app(scope, receive, send)
 
 
 class BodyLimit:

@@ -15,6 +15,7 @@ with its quotes, backslashes and control characters escaped.
 from __future__ import annotations
 
 import io
+import json
 import math
 import re
 from collections.abc import Iterable, Mapping
@@ -23,6 +24,8 @@ from typing import Any
 _BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
 _ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f"}
 _ESCAPES["\r"] = "\\r"
+#: Every character str.splitlines() breaks a line at: a CSV reader, an editor or pandas may too.
+LINE_BREAKS = frozenset("\n\r\v\f\x1c\x1d\x1e\x85\u2028\u2029")
 
 
 class TomlError(ValueError):
@@ -130,12 +133,26 @@ def trajectory_csv(
     columns = trajectory_columns(run, units)
     out = io.StringIO()
     for line in comments:
-        out.write("# " + line.replace("\n", " ").replace("\r", " ") + "\n")
+        out.write("# " + one_line(line) + "\n")
     out.write(",".join(_header_cell(name, unit) for name, unit in columns) + "\n")
     series = [_series(run, name) for name, _ in columns]
     for row in zip(*series, strict=True):
         out.write(",".join("nan" if v is None else repr(float(v)) for v in row) + "\n")
     return out.getvalue()
+
+
+def json_text(value: Any) -> str:
+    """``value`` as JSON on one line that reads back equal: U+0085, U+2028 and U+2029, which
+    JSON keeps raw and str.splitlines() breaks at, written as \\u escapes (the others are
+    control characters, which JSON escapes itself)."""
+    text = json.dumps(value, ensure_ascii=False)
+    return "".join(f"\\u{ord(ch):04x}" if ch in LINE_BREAKS else ch for ch in text)
+
+
+def one_line(text: str) -> str:
+    """``text`` with each line break (`LINE_BREAKS`, U+2028 and U+0085 too) as a space: a comment
+    that a title or a stop message split would start a data row in the middle of the header."""
+    return "".join(" " if ch in LINE_BREAKS else ch for ch in text)
 
 
 def stats_lines(stats: Mapping[str, Any], prefix: str = "stats.") -> list[str]:
@@ -154,4 +171,4 @@ def _header_cell(name: str, unit: str) -> str:
     and a line break, a comma, a quote or a '#' in it would add rows, split columns or hide the
     rest of the header from a reader that skips '#' comments. Those characters are replaced."""
     cell = f"{name} [{unit}]" if unit else name
-    return "".join(" " if ch in '\r\n\t,"#' or ord(ch) < 32 else ch for ch in cell)
+    return "".join(" " if ch in '\t,"#' or ord(ch) < 32 else ch for ch in one_line(cell))

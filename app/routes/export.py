@@ -37,7 +37,13 @@ from app.schemas import (
     SimulateRequest,
     ValidationErrors,
 )
-from mechanics.export_formats import spec_toml, stats_lines, trajectory_columns, trajectory_csv
+from mechanics.export_formats import (
+    json_text,
+    spec_toml,
+    stats_lines,
+    trajectory_columns,
+    trajectory_csv,
+)
 from mechanics.export_share import (
     PAGE_SETTINGS,
     PAGE_T_END,
@@ -222,9 +228,14 @@ async def get_script(scene_id: SceneId, http: Request) -> Response:
 
 
 async def _script(request: SimulateRequest, http: Request) -> str:
+    """The script of a run /simulate makes: the run itself first, so a request /simulate refuses
+    (g = 1e308 overflows in the first step, found only by stepping) is refused here with the
+    same 422, not written as a script that crashes (hostile play-test). A built-in scene's run
+    is kept (app/memo.py): the trajectory of the same query costs nothing after it."""
     from mechanics.export_script import run_script
     from mechanics.simulate import SimulationRequest
 
+    await simulation_answer(request, http, gzip_ok=False)
     options = SimulationRequest(
         **request.model_dump(include=set(SimulationRequest.__dataclass_fields__))
     )
@@ -323,7 +334,7 @@ async def _trajectory(request: SimulateRequest, http: Request, format: str) -> R
         }
         return _download(orjson.dumps(body), "application/json", f"{stem}_trajectory.json")
     comments = [f"Lagrange Lab trajectory of {described['scene']}"]
-    comments += [f"{k}: {json.dumps(v, ensure_ascii=False)}" for k, v in described.items()]
+    comments += [f"{k}: {json_text(v)}" for k, v in described.items()]
     comments += stats_lines(run["stats"]) + [f"warning: {w}" for w in run["warnings"]]
     return _download(trajectory_csv(run, units, comments), CSV, f"{stem}_trajectory.csv")
 
@@ -595,8 +606,9 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
     """The /simulate request a scene page's query string describes (see static/js/controls.js
     writeQuery): values by name, ``method``, ``tol`` (rtol and atol), ``dt``, ``t_end``. The
     page's other settings (``lecture``, ``phase``, ``compare``, ...) are the page's and are
-    passed over; a key that names nothing in the scene nor the page, a key given twice, or a
-    value that is not a finite decimal number is a 422 naming it."""
+    passed over; a key that names nothing in the scene nor the page, or a value that is not a
+    finite decimal number, is a 422 naming it (a key given twice is refused before any route,
+    app/middleware.py OneValuePerKey)."""
     _known(scene_id)
     if len(http.url.query) > MAX_QUERY:
         raise HTTPException(422, [{"field": "query", "message": f"over {MAX_QUERY} characters"}])
@@ -616,10 +628,6 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
                     f"({_names(PAGE_SETTINGS)})",
                 }
             )
-        elif len(query.getlist(key)) > 1:
-            errors.append(
-                {"field": key, "message": f"given {len(query.getlist(key))} times: give it once"}
-            )
     if errors:
         raise HTTPException(422, errors)
 
@@ -632,8 +640,9 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
         value = float(raw) if _DECIMAL.match(raw) else math.nan
         if not math.isfinite(value):
             if not any(e["field"] == key for e in errors):  # tol is read twice
+                digits = "" if raw.isascii() else " (written with the digits 0-9)"
                 errors.append(
-                    {"field": key, "message": f"must be a finite number, not {raw[:40]!r}"}
+                    {"field": key, "message": f"must be a finite number{digits}, not {raw[:40]!r}"}
                 )
             return None
         return value
@@ -671,7 +680,9 @@ def _page_request(scene_id: str, http: Request) -> SimulateRequest:
 
 
 #: A decimal number: what the page writes (String of a double, repr on the server).
-_DECIMAL = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?$")
+#: ASCII digits only: Python's \d and float() also read '１' (a fullwidth 1) and '١' (an
+#: Arabic-Indic 1), which the page's Number() reads as NaN (hostile play-test).
+_DECIMAL = re.compile(r"^[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?$", re.ASCII)
 
 
 def _names(names: Collection[str]) -> str:

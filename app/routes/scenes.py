@@ -5,7 +5,9 @@ preview (mechanics/jscode.py)."""
 from __future__ import annotations
 
 import functools
-from collections import OrderedDict
+import hashlib
+import re
+from collections.abc import Callable
 from typing import Any
 
 from fastapi import APIRouter, HTTPException, Request, Response
@@ -13,6 +15,7 @@ from pydantic import BaseModel, ConfigDict
 from starlette.concurrency import run_in_threadpool
 
 from app.schemas import Message, SceneDetail, SceneSpec, SceneSummary, ValidationErrors
+from mechanics import cache
 from mechanics.scenes import list_scenes, load_scene, scene_ids
 
 router = APIRouter(prefix="/api/v1/scenes", tags=["scenes"])
@@ -50,8 +53,6 @@ async def get_catalog(request: Request) -> Response:
 
 @functools.lru_cache(maxsize=1)
 def _catalog() -> tuple[bytes, str]:
-    import hashlib
-
     import orjson
 
     from mechanics.simulate import SimulationRequest, simulate
@@ -78,11 +79,24 @@ class LiveRequest(BaseModel):
     scene: SceneSpec
 
 
-#: Posted specs' modules by content hash, in this process (the least recently asked dropped past
-#: the limit). With several server processes a module's GET may reach another one and miss: a
-#: 404 the page answers by keeping server runs.
-_POSTED: OrderedDict[str, bytes] = OrderedDict()
-_POSTED_LIMIT = 256
+#: Posted specs' modules by content hash, in the project's shared cache (mechanics/cache.py: the
+#: disk every worker of a server reads, or Redis every server reads), so the GET that follows a
+#: POST finds the module whichever worker it reaches (hostile play-test: with --workers 2 a
+#: module kept in one worker's memory was a 404 in 7 of 12 GETs). An entry is verified on
+#: read: its source must hash to the digest it is asked by.
+LIVE_STORE = "live-module"
+cache.STORES.setdefault(LIVE_STORE, cache.Store(LIVE_STORE, ttl_seconds=30 * cache.DAY))
+_DIGEST = re.compile(r"^[0-9a-f]{16}$")
+
+
+def _module_of(digest: str) -> Callable[[Any], bool]:
+    """The check of a stored module: a source whose hash is ``digest`` (jscode.LiveModule's)."""
+
+    def check(value: Any) -> bool:
+        source = value["source"]
+        return hashlib.sha256(source.encode()).hexdigest()[:16] == digest
+
+    return check
 
 
 @router.post(
@@ -108,12 +122,11 @@ def post_live(request: LiveRequest, http: Request) -> Response:
         )
     except JsUnavailable as exc:
         raise HTTPException(status_code=503, detail=f"no live preview: {exc}") from None
-    source = live.pop("source").encode()
+    source = live.pop("source")
     digest = live.pop("digest")
-    _POSTED[digest] = source
-    _POSTED.move_to_end(digest)
-    while len(_POSTED) > _POSTED_LIMIT:
-        _POSTED.popitem(last=False)
+    cache.get_or_compute(
+        LIVE_STORE, {"digest": digest}, lambda: {"source": source}, validate=_module_of(digest)
+    )
     body = {"module": f"/api/v1/scenes/live/{digest}.js", **live}
     return Response(orjson.dumps(body), media_type="application/json")
 
@@ -125,8 +138,10 @@ def post_live(request: LiveRequest, http: Request) -> Response:
 )
 def get_posted_module(digest: str, request: Request) -> Response:
     """The module ``POST /live`` printed, immutable under its hash."""
-    source = _POSTED.get(digest)
-    if source is None:
+    found = None
+    if _DIGEST.match(digest):
+        found = cache.get(LIVE_STORE, {"digest": digest}, validate=_module_of(digest))
+    if found is None:
         raise HTTPException(
             status_code=404,
             detail=[
@@ -137,7 +152,7 @@ def get_posted_module(digest: str, request: Request) -> Response:
                 }
             ],
         )
-    return _cached(request, source, digest, "text/javascript", IMMUTABLE)
+    return _cached(request, found["source"].encode(), digest, "text/javascript", IMMUTABLE)
 
 
 @router.get(
