@@ -19,12 +19,22 @@ Only points in the asymptotic range enter a fit: a point whose error is at the r
 floor (rounding, or the reference's own error) or so large that the method is not yet
 converging (beyond stability, or no digit right) is shown but excluded, with the reason.
 
-The long run sets symplectic Euler beside RK4 at the same step over ~10³ periods: where the
-mass matrix is constant the first keeps its energy error bounded (it conserves a modified
-energy exactly), the second's drifts one way; where M changes with the coordinates (a double
-pendulum) symplectic Euler stepping (q, q̇) is not symplectic, and the result says so.
-Everything is bounded: each run gets what is left of one wall-time budget, and the
-long run has its own cap on steps and seconds; a run cut short says so and stays out of fits.
+The long run sets symplectic Euler beside RK4 at the same step over up to 10³ periods: on a
+conservative, autonomous motion with a constant mass matrix the first keeps its energy error
+bounded (it conserves a modified energy exactly), the second's drifts one way. Anywhere else
+(`why_not_symplectic`: a damper, friction or a drive doing work, L depending on t, M changing
+with the coordinates) the result says why not in words. There is no long run past a stop (the
+equations there describe a motion the system does not have) nor without a period (a motion that
+never repeats has no "periods", and a bounded error needs a bounded motion): the answer says so.
+
+A chaotic motion makes every error grow like e^(λt): past the predictability horizon even the
+reference has no digit right, and the points measure the system, not the methods. A second
+reference at a looser tolerance finds that horizon (mechanics/divergence.py, as /simulate's
+sensitivity check does), and the answer warns and says so on the points it concerns.
+
+Everything is bounded: one wall-time budget per request covers the comparisons and the long run
+(whose length in periods is what fits in what is left); a run cut short says so and stays out
+of fits.
 """
 
 from __future__ import annotations
@@ -35,7 +45,9 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import sympy as sp
 
+from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.integrators import METHODS, Trajectory, integrate
 from mechanics.native import NativeUnavailable
 from mechanics.numeric import CompiledScene, compiled_scene, compiled_spec, evaluate
@@ -47,21 +59,34 @@ from mechanics.simulate import (
     constant_mass_matrix,
 )
 from mechanics.spec import SpecError
+from mechanics.steps.conserved import explicit_time, vanishes
 
 MAX_METHODS = 6
 MAX_SETTINGS = 8
 MAX_T_END = 100.0
+#: A shorter run compares nothing but round-off (t_end = 1e-300 ran at steps of 1e-302).
+MIN_T_END = 1e-3
 #: Fixed steps one run may take, and all fixed-step runs of one request together.
 MAX_STEPS_PER_RUN = 200_000
 MAX_STEPS_TOTAL = 1_000_000
-#: Seconds for the comparison runs of one request (the reference included), and for the long run.
+#: Seconds for all the runs of one call (the reference, the comparisons and the long run), and
+#: the share the comparisons get when a long run is asked for too. The route gives a request
+#: 4.5 s (app/routes/precision.py); a script or a test may give more.
 MAX_SECONDS = 12.0
+COMPARISON_SHARE = 0.6
+#: Seconds of a long run called on its own (`long_run`); within a request it gets what is left.
 LONG_RUN_SECONDS = 8.0
 LONG_RUN_PERIODS = 1000
+#: A long run shorter than this says too little about drift against bounded error: it is cut
+#: (and says so) rather than shortened further.
+LONG_RUN_MIN_PERIODS = 100
 LONG_RUN_STEPS_PER_PERIOD = 30
 LONG_RUN_MAX_STEPS = 30_000
 #: The reference: DOP853 at the tightest tolerance the validation allows anyone.
 REF_TOL = 1e-13
+#: The second reference that tells where the first stops being one (1000× looser, as /simulate's
+#: sensitivity check re-runs).
+CHECK_TOL = 1e-10
 #: Samples along each run, for its energy error (and the reference's final state).
 SAMPLES = 201
 #: Errors below FLOOR × (1 + |state|) are at the reference's own accuracy; above CEILING × the
@@ -103,8 +128,8 @@ def check_precision_request(req: PrecisionRequest) -> None:
     for i, m in enumerate(req.methods):
         if m not in METHODS:
             bad(f"methods[{i}]", f"unknown method; one of {', '.join(METHODS)}")
-    if not (math.isfinite(req.t_end) and 0 < req.t_end <= MAX_T_END):
-        bad("t_end", f"must be > 0 and ≤ {MAX_T_END:g} s")
+    if not (math.isfinite(req.t_end) and MIN_T_END <= req.t_end <= MAX_T_END):
+        bad("t_end", f"must be ≥ {MIN_T_END:g} s and ≤ {MAX_T_END:g} s")
     for name, values in (("steps", req.steps), ("tolerances", req.tolerances)):
         if values is None:
             continue
@@ -115,6 +140,9 @@ def check_precision_request(req: PrecisionRequest) -> None:
                 bad(f"steps[{i}]", "must be a finite step > 0")
             elif name == "steps" and math.isfinite(req.t_end) and req.t_end / v > MAX_STEPS_PER_RUN:
                 bad(f"steps[{i}]", f"t_end / step exceeds {MAX_STEPS_PER_RUN} steps")
+            elif name == "steps" and math.isfinite(req.t_end) and v > req.t_end * (1 + 1e-9):
+                # it ran as one step of t_end, so two such steps were one point said twice
+                bad(f"steps[{i}]", f"must be ≤ t_end = {req.t_end:g} s (it would not be taken)")
             elif name == "tolerances" and not (math.isfinite(v) and 1e-12 <= v <= 1e-2):
                 bad(f"tolerances[{i}]", "must be in [1e-12, 0.01] (above the reference's 1e-13)")
     if errors:
@@ -217,7 +245,8 @@ def energy_error(c: CompiledScene, params: list[float], run: Trajectory) -> np.n
         if c.drive is not None:
             (e_minus_h,) = evaluate(c.drive, t, q, qd, params)
             value = value - (e_minus_h - e_minus_h[0]) - (y[:, 2 * n + 1] if c.extras > 1 else 0)
-    return np.abs(value - value[0]) / scale
+    with np.errstate(invalid="ignore"):  # a run that blew up: NaN, reported as no error
+        return np.abs(value - value[0]) / scale
 
 
 def _grid(t_end: float, dt: float | None) -> tuple[np.ndarray, float | None]:
@@ -229,6 +258,9 @@ def _grid(t_end: float, dt: float | None) -> tuple[np.ndarray, float | None]:
     intervals = max(1, min(SAMPLES - 1, math.ceil(t_end / dt - 1e-9)))
     per = max(1, math.ceil(t_end / intervals / dt - 1e-9))  # a step past t_end: one step
     return np.linspace(0.0, t_end, intervals + 1), t_end / (intervals * per)
+
+
+NOT_CONVERGING = "not converging yet (no digit right, or beyond stability)"
 
 
 def _point(
@@ -248,7 +280,7 @@ def _point(
     elif err <= FLOOR * scale:
         excluded = "at the reference's floor (rounding, not the method)"
     elif err >= CEILING * scale:
-        excluded = "not converging yet (no digit right, or beyond stability)"
+        excluded = NOT_CONVERGING
     return {
         "wall_time": cost.wall_time,
         "rhs_evaluations": cost.nfev,
@@ -287,8 +319,8 @@ def work_precision(
     reference_seconds = time.perf_counter() - start
     scale = 1.0 + float(np.max(np.abs(reference)))
     steps, tolerances = settings_of(req)
-    # symplectic Euler and the implicit midpoint step (q, q̇): symplectic only where M is constant
-    symplectic_here = constant_mass_matrix(c)
+    horizon = predictability(c, params, y0, req.t_end, reference, clock)
+    not_symplectic = why_not_symplectic(c, params)
     methods = []
     for name in req.methods:
         info = METHODS[name]
@@ -300,6 +332,16 @@ def work_precision(
             run = _run(c, params, y0, t_eval, name, clock, **kw)
             cost = run if fixed else _run(c, params, y0, t_eval[[0, -1]], name, clock, **kw)
             point = _point(c, params, run, cost, reference_on(t_eval), scale)
+            if fixed and setting > req.t_end * (1 + 1e-9):
+                point["excluded"] = (
+                    f"the step is longer than the motion, which ends at t = {req.t_end:.3g} s: "
+                    "it ran as one step of that length"
+                )
+            if horizon is not None and point["excluded"] == NOT_CONVERGING:
+                point["excluded"] = (
+                    f"past the predictability horizon (t ≈ {horizon.trusted_until:.3g} s): "
+                    "the error measures the motion's sensitivity, not the method"
+                )
             points.append({"setting": setting, "h": h, **point})
         if fixed:
             leave_out_pre_asymptotic(points)
@@ -312,7 +354,8 @@ def work_precision(
                 "label": info.label,
                 "kind": info.kind,
                 "order": info.order,
-                "symplectic": bool(info.symplectic) and symplectic_here,
+                "symplectic": bool(info.symplectic) and not_symplectic is None,
+                "not_symplectic": not_symplectic if info.symplectic else None,
                 "fitted_order": None if slope is None else (slope if fixed else -slope),
                 "fitted_against": "step h" if fixed else "RHS evaluations",
                 "points_in_fit": len(used),
@@ -326,14 +369,116 @@ def work_precision(
         "methods": methods,
         "seconds": seconds - clock.left(),
         "cut": clock.left() == 0.0,
+        "warnings": [horizon_warning(horizon, req.t_end)] if horizon is not None else [],
     }
 
 
-def period_of(c: CompiledScene, params: list[float], y0: np.ndarray, t_end: float) -> float | None:
+def predictability(
+    c: CompiledScene,
+    params: list[float],
+    y0: np.ndarray,
+    t_end: float,
+    reference: np.ndarray,
+    clock: _Clock,
+) -> Any:
+    """How the reference and a second one at CHECK_TOL part (mechanics/divergence.py), when they
+    part by 1 % of the motion before t_end; None when they do not (the reference holds), or when
+    the second one did not finish (no claim either way)."""
+    t_eval = np.linspace(0.0, t_end, SAMPLES)
+    other = _run(c, params, y0, t_eval, "dop853_c", clock, rtol=CHECK_TOL, atol=CHECK_TOL)
+    if other.status != "ok" or not worth_classifying(c.n, reference, other.y):
+        return None
+    verdict = compare_runs(c, params, t_eval, reference, other.y, (REF_TOL, CHECK_TOL))
+    return verdict if verdict.trusted_until is not None else None
+
+
+def horizon_warning(verdict: Any, t_end: float) -> str:
+    """The sentence on a comparison that runs past where its reference stops being one."""
+    parted = verdict.trusted_until
+    if verdict.kind == "exponential":
+        # a 1000× tighter run buys ln(1000)/λ more: past that the 1e-13 reference is lost too
+        lost = parted + math.log(CHECK_TOL / REF_TOL) / verdict.rate
+        why = (
+            f"The motion is chaotic here: two reference runs (DOP853 at {REF_TOL:g} and "
+            f"{CHECK_TOL:g}) part like e^(λt) with λ ≈ {verdict.rate:.2g} /s and differ by 1 % "
+            f"of the motion from t ≈ {parted:.3g} s; from about t ≈ {lost:.3g} s even the "
+            f"{REF_TOL:g} reference has no digit right."
+        )
+    else:
+        why = (
+            f"Two reference runs (DOP853 at {REF_TOL:g} and {CHECK_TOL:g}) differ by 1 % of the "
+            f"motion from t ≈ {parted:.3g} s: past there the reference is not to be trusted."
+        )
+    return (
+        f"{why} The errors at t_end = {t_end:g} s measure the system's sensitivity past its "
+        "predictability horizon, not the methods: a point with no digit right says nothing "
+        f"about its method. For a work–precision diagram take t_end below about {parted:.3g} s."
+    )
+
+
+def why_not_symplectic(c: CompiledScene, params: list[float]) -> str | None:
+    """Why symplectic Euler and the implicit midpoint step do not keep a modified energy on this
+    motion, in the words the page shows; None where they do. One rule for every claim of a
+    bounded energy error (the methods' rows, the long run).
+
+    They do on the flow of a Hamiltonian H(q, p) free of t, stepped in variables that are a
+    linear change of (q, p): L free of t, no power of the non-conservative forces (judged at
+    these parameters: a damper with c = 0 does no work), M constant (p = M q̇), and q̈ free of
+    q̇ (their explicit update of q̇ is the symplectic one only for forces of q alone). A damped,
+    driven or rubbing motion conserves no energy at all (the error measured is the energy
+    balance's), so there is nothing for a modified energy to stay close to."""
+    m, work = c.derivation.model, c.derivation.work
+    values = {
+        m.params[name]: sp.Rational(repr(float(v)))
+        for name, v in zip(c.parameters, params, strict=True)
+    }
+    Q = [sp.sympify(q).xreplace(values) for q in work.Q]
+    power = sp.expand(sum((q * qd for q, qd in zip(Q, m.qd, strict=True)), sp.S.Zero))
+    if not vanishes(power, m):
+        return (
+            "non-conservative forces do work on this motion (a damper, friction or a driving "
+            "force: Σ Q_j q̇_j ≠ 0), so its energy is not conserved and there is no conserved "
+            "energy for symplectic Euler to stay close to; the error shown is that of the energy "
+            "balance ΔT + ΔV − W_NC, which is not bound to stay bounded"
+        )
+    if explicit_time(work.L.xreplace(values), m):
+        return (
+            "L depends explicitly on t (a driven or moving support), so no energy is conserved "
+            "and there is no fixed Hamiltonian whose modified version symplectic Euler could keep"
+        )
+    if not constant_mass_matrix(c):
+        return (
+            "the mass matrix changes with the coordinates, so symplectic Euler, which steps q and "
+            "q̇ rather than the momenta p = M(q) q̇, is not symplectic here: its energy error is "
+            "not bound to stay bounded"
+        )
+    forcing = work.forcing if work.forcing is not None else work.accelerations
+    if forcing is None:
+        return "the equations were too large to check whether the forces depend on q̇ or on t"
+    for f in forcing:
+        f = sp.sympify(f).xreplace(values)
+        if f.has(*m.qd) or explicit_time(f, m):
+            return (
+                "the forces depend on the velocities (a gyroscopic force, like a magnetic one), "
+                "and symplectic Euler's explicit update of q̇ is not the symplectic map of such "
+                "a flow"
+            )
+    return None
+
+
+def period_window(t_end: float) -> float:
+    """How long a motion is watched for a period (and for a stop after t_end): 4·t_end, and at
+    least 20 s (a double pendulum asked for 1 s turns back twice only by about 3 s)."""
+    return min(max(4 * t_end, 20.0), 4 * MAX_T_END)
+
+
+def period_of(
+    c: CompiledScene, params: list[float], y0: np.ndarray, t_end: float, seconds: float = 2.0
+) -> float | None:
     """The motion's period from its first coordinate's turning points (q̇₁ changes sign from + to
-    − once a period) over a reference run of up to 4·t_end; None if it never turns twice."""
-    t_eval = np.linspace(0.0, 4 * t_end, 4001)
-    run = _run(c, params, y0, t_eval, "dop853_c", _Clock(2.0), rtol=1e-10, atol=1e-10)
+    − once a period) over a reference run of `period_window`; None if it never turns twice."""
+    t_eval = np.linspace(0.0, period_window(t_end), 4001)
+    run = _run(c, params, y0, t_eval, "dop853_c", _Clock(seconds), rtol=1e-10, atol=1e-10)
     v = run.y[:, c.n]
     i = np.nonzero((v[:-1] > 0) & (v[1:] <= 0))[0]
     if len(i) < 2:
@@ -343,30 +488,40 @@ def period_of(c: CompiledScene, params: list[float], y0: np.ndarray, t_end: floa
     return float(np.mean(np.diff(crossings)))
 
 
+#: Symplectic Euler's share of a long run's seconds: one evaluation a step against RK4's four.
+SYMPLECTIC_SHARE = 0.3
+
+
 def long_run(
     c: CompiledScene,
     params: list[float],
     y0: np.ndarray,
     t_end: float,
     seconds: float = LONG_RUN_SECONDS,
+    *,
+    period: float | None = None,
+    periods: int = LONG_RUN_PERIODS,
 ) -> dict[str, Any]:
-    """Symplectic Euler against RK4 at one step h = period / 30 over 1000 periods (fewer
-    when the step budget or the time budget says so): each run's energy error envelope, the
-    largest |ΔE| in each of 100 windows, and whether it was cut (each method gets half of
-    ``seconds``)."""
-    period = period_of(c, params, y0, t_end)
-    basis = "turning points of the first coordinate" if period else "t_end (no period found)"
-    period = period or t_end
+    """Symplectic Euler against RK4 at one step h = period / 30 over ``periods`` periods (a
+    multiple of 20, at most 1000): each run's energy error envelope, the largest |ΔE| in each of
+    100 windows, and whether it was cut by ``seconds`` (symplectic Euler gets 30 % of them, RK4
+    the rest). ``period`` None finds it (`period_of`); a motion without one is refused, since
+    "periods" of it would be an invented time scale (`long_run_or_why` says so in words)."""
+    if period is None:
+        period = period_of(c, params, y0, t_end)
+    if period is None:
+        raise ValueError("no period found: the motion does not repeat within period_window(t_end)")
     h = period / LONG_RUN_STEPS_PER_PERIOD
-    periods = min(LONG_RUN_PERIODS, LONG_RUN_MAX_STEPS // LONG_RUN_STEPS_PER_PERIOD)
+    periods = max(20, min(periods, LONG_RUN_MAX_STEPS // LONG_RUN_STEPS_PER_PERIOD) // 20 * 20)
     windows = 100
     # two steps between samples: the steps land on the samples unchanged (h stays period / 30),
     # and 15 samples a period find each period's largest T and |ΔE| (one a period would alias)
     samples_per_window = periods * (LONG_RUN_STEPS_PER_PERIOD // 2) // windows
     t_eval = np.linspace(0.0, periods * period, windows * samples_per_window + 1)
     runs = {}
-    for method in ("symplectic_euler", "rk4"):
-        run = _run(c, params, y0, t_eval, method, _Clock(seconds / 2), dt=h)
+    clock = _Clock(seconds)
+    for method, share in (("symplectic_euler", SYMPLECTIC_SHARE), ("rk4", 1.0)):
+        run = _run(c, params, y0, t_eval, method, _Clock(clock.left() * share), dt=h)
         err = energy_error(c, params, run)
         reached = len(err) - 1
         env = [
@@ -381,15 +536,64 @@ def long_run(
             "rhs_evaluations": run.nfev,
             "wall_time": run.wall_time,
         }
+    not_symplectic = why_not_symplectic(c, params)
     return {
-        # symplectic Euler keeps its energy error bounded only where it is symplectic: M constant
-        "symplectic_here": constant_mass_matrix(c),
+        # a bounded energy error is symplectic Euler's only on a conservative autonomous motion
+        # with M constant
+        "symplectic_here": not_symplectic is None,
+        "not_symplectic": not_symplectic,
         "period": period,
-        "period_from": basis,
+        "period_from": "turning points of the first coordinate",
         "periods": periods,
         "h": h,
         "runs": runs,
     }
+
+
+def periods_that_fit(
+    c: CompiledScene, params: list[float], y0: np.ndarray, period: float, seconds: float
+) -> int:
+    """How many periods (a multiple of 20, LONG_RUN_MIN_PERIODS … LONG_RUN_PERIODS) the long run
+    can take in ``seconds``, from the cost of 150 RK4 steps timed here: the request's budget
+    decides the length, which the answer reports (``periods``), rather than cutting both runs."""
+    h = period / LONG_RUN_STEPS_PER_PERIOD
+    probe = _run(c, params, y0, np.array([0.0, 150 * h]), "rk4", _Clock(0.2), dt=h)
+    per_step = probe.wall_time / max(probe.nsteps, 1)
+    # RK4's step, symplectic Euler's (~40 % of it), the energy along both, and a margin for a
+    # machine whose load changes between the probe and the runs
+    per_period = LONG_RUN_STEPS_PER_PERIOD * per_step * 1.4 * 1.6
+    fit = int(seconds / per_period) // 20 * 20 if per_period > 0 else LONG_RUN_PERIODS
+    return max(LONG_RUN_MIN_PERIODS, min(LONG_RUN_PERIODS, fit))
+
+
+def long_run_or_why(
+    c: CompiledScene,
+    params: list[float],
+    y0: np.ndarray,
+    req: PrecisionRequest,
+    stop: dict[str, Any] | None,
+    seconds: float,
+) -> tuple[dict[str, Any] | None, str | None]:
+    """The long run, or why there is none, in the words the page shows: not past a stop (before
+    t_end, or within the stretch watched for a period: a motion that repeats and has not met
+    its stop there never will), and not of a motion with no period."""
+    clock = _Clock(seconds)
+    window = period_window(req.t_end)
+    stop = stop or _model_ends(c, replace(req, t_end=window))
+    if stop is not None:
+        return None, (
+            f"No long run: the motion ends at t = {stop['t']:.3g} s ({stop['message']}), and "
+            "past that stop the equations describe a motion the system does not have."
+        )
+    period = period_of(c, params, y0, req.t_end, seconds=min(2.0, clock.left() / 4))
+    if period is None:
+        return None, (
+            f"No long run: the motion does not repeat (its first coordinate does not turn back "
+            f"twice within {window:.3g} s), so it has no periods to count, and symplectic "
+            "Euler's bounded energy error is a property of bounded, repeating motion."
+        )
+    periods = periods_that_fit(c, params, y0, period, clock.left())
+    return long_run(c, params, y0, req.t_end, clock.left(), period=period, periods=periods), None
 
 
 def reference_failed(
@@ -440,7 +644,10 @@ def reference_failed(
 
 
 def precision_compiled(c: CompiledScene, req: PrecisionRequest, seconds: float) -> dict[str, Any]:
+    """Every run of one request within ``seconds``: the comparisons first (COMPARISON_SHARE of
+    them when a long run is asked for), the long run in what is left."""
     check_precision_request(req)
+    clock = _Clock(seconds)
     # the parameters and the start checked as /simulate checks them (names, bounds, a state where
     # the equations hold); the method and output rate there are placeholders that pass
     sim = SimulationRequest(
@@ -450,9 +657,12 @@ def precision_compiled(c: CompiledScene, req: PrecisionRequest, seconds: float) 
     stop = _model_ends(c, req)
     if stop is not None:  # compare the motion the system has, not the equations' beyond it
         req = replace(req, t_end=stop["t"])
-    out = work_precision(c, params, y0, req, seconds)
+    share = COMPARISON_SHARE if req.long_run and stop is None else 1.0
+    out = work_precision(c, params, y0, req, clock.left() * share)
     out["scene_parameters"] = dict(zip(c.parameters, params, strict=True))
-    out["long_run"] = long_run(c, params, y0, req.t_end) if req.long_run else None
+    out["long_run"], out["long_run_declined"] = (
+        long_run_or_why(c, params, y0, req, stop, clock.left()) if req.long_run else (None, None)
+    )
     out["stopped"] = stop
     return out
 

@@ -25,8 +25,8 @@ router = APIRouter(prefix="/api/v1", tags=["precision"])
 
 answers = AnswerMemo(max_entries=128, max_bytes=16 * 1024 * 1024)
 
-#: Seconds for one request's comparison runs (the long run has its own 8 s).
-SECONDS = 12.0
+#: Seconds for all the runs of one request, the long run's included (every answer < 5 s).
+SECONDS = 4.5
 
 
 class PrecisionIn(DeriveRequest):
@@ -59,8 +59,8 @@ class PrecisionIn(DeriveRequest):
     steps: list[Finite] | None = Field(
         default=None,
         max_length=8,
-        description="Steps (s) for the fixed-step methods, up to 8; default t_end/100 … "
-        "t_end/3200. At most 200000 steps a run.",
+        description="Steps (s) for the fixed-step methods, up to 8, each ≤ t_end; default "
+        "t_end/100 … t_end/3200. At most 200000 steps a run.",
     )
     tolerances: list[Finite] | None = Field(
         default=None,
@@ -68,10 +68,11 @@ class PrecisionIn(DeriveRequest):
         description="rtol = atol for the adaptive methods, up to 8 in [1e-12, 0.01]; default "
         "1e-4 … 1e-10.",
     )
-    t_end: Finite = Field(default=10.0, description="Seconds of motion (≤ 100).")
+    t_end: Finite = Field(default=10.0, description="Seconds of motion (0.001 … 100).")
     long_run: bool = Field(
         default=False,
-        description="Also symplectic Euler against RK4 at one step over 1000 periods (≤ 8 s).",
+        description="Also symplectic Euler against RK4 at one step over up to 1000 periods (as "
+        "many as fit in the request's time): not past a stop, nor of a motion with no period.",
     )
 
 
@@ -93,8 +94,14 @@ class MethodPoints(BaseModel):
     kind: str
     order: int = Field(description="The method's order (the registry's).")
     symplectic: bool = Field(
-        description="Symplectic on this scene: a symplectic method stepping (q, q̇) is only "
-        "where the mass matrix is constant."
+        description="Symplectic on this motion, its energy error bound to stay bounded: a "
+        "symplectic method stepping (q, q̇) is only on a conservative motion (no damper, friction "
+        "or drive doing work) with L free of t, a constant mass matrix and forces of q alone."
+    )
+    not_symplectic: str | None = Field(
+        default=None,
+        description="For a method symplectic where those hold (symplectic_euler, "
+        "implicit_midpoint): why it is not on this motion, in words; null otherwise.",
     )
     fitted_order: float | None = Field(
         description="Least-squares slope of log error against log h (fixed step), or minus the "
@@ -107,12 +114,16 @@ class MethodPoints(BaseModel):
 
 class LongRunOut(BaseModel):
     symplectic_here: bool = Field(
-        description="Whether symplectic Euler is symplectic on this scene: it steps (q, q̇), "
-        "which is a linear change of (q, p) only where the mass matrix is constant."
+        description="Whether symplectic Euler keeps its energy error bounded here: only on a "
+        "conservative motion (no damper, friction or drive doing work) with L free of t, a "
+        "constant mass matrix (it steps q̇, not p) and forces of q alone."
+    )
+    not_symplectic: str | None = Field(
+        default=None, description="Why symplectic_here is false, in words; null when true."
     )
     period: float
     period_from: str
-    periods: int
+    periods: int = Field(description="Periods run: up to 1000, as many as fit in the time.")
     h: float
     runs: dict[str, dict[str, Any]] = Field(
         description="Per method: t and the largest energy error in each window, status, cost."
@@ -128,6 +139,16 @@ class PrecisionOut(BaseModel):
     cut: bool = Field(description="True when the time budget ran out (later points stopped).")
     scene_parameters: dict[str, float]
     long_run: LongRunOut | None
+    long_run_declined: str | None = Field(
+        default=None,
+        description="Why a long run asked for was not run (the motion ends at a stop, or has no "
+        "period), in words; null otherwise.",
+    )
+    warnings: list[str] = Field(
+        default=[],
+        description="What the numbers cannot say: a comparison past the motion's "
+        "predictability horizon (chaos), where the errors measure the system, not the methods.",
+    )
     stopped: dict[str, Any] | None = Field(
         default=None,
         description="Where the motion ends at a declared stop before t_end ({t, message}): "
@@ -170,7 +191,8 @@ def _encoded(result: dict) -> tuple[bytes, bool]:
 async def post_precision(body: PrecisionIn, http: Request) -> Response:
     """Each method at each step or tolerance: wall time and RHS evaluations against the error
     (against DOP853 at 1e-13) and the energy error, with each method's order fitted from the
-    points in the asymptotic range; optionally symplectic Euler against RK4 over 1000 periods."""
+    points in the asymptotic range; optionally symplectic Euler against RK4 over up to 1000
+    periods."""
     from mechanics.precision import check_precision_request, precision, precision_job
 
     options = _options(body)
@@ -198,9 +220,9 @@ async def post_precision(body: PrecisionIn, http: Request) -> Response:
                 SECONDS,
                 affinity=spec_key,
                 what="the work–precision runs of this scene",
-                # the derivation's own budget, then the runs', the long run's 8 s, the 2 s run that
-                # finds its period, and building the scene's C for the reference
-                seconds=derive_seconds() + SECONDS + 15.0,
+                # the derivation's own budget, then the runs' (the long run's included), and
+                # building the scene's C for the reference
+                seconds=derive_seconds() + SECONDS + 5.0,
             )
             return _encoded(result)
 

@@ -1,7 +1,9 @@
 // The work–precision panel (POST /api/v1/precision): pick methods and a step or tolerance range,
 // Run, and see error against wall time and against RHS evaluations, energy error against RHS
 // evaluations (log–log), each method's fitted order beside its textbook order, and optionally
-// symplectic Euler's bounded energy error beside RK4's drift over 1000 periods.
+// symplectic Euler beside RK4 over up to 1000 periods: the bounded energy error against the drift
+// where the motion is conservative, autonomous and M is constant, and why not elsewhere (the API
+// says it in words: `not_symplectic`, `long_run_declined`, `warnings`).
 //
 //   import { mountPrecision } from "./precision.js";
 //   mountPrecision(container, { sceneId, getState: () => ({ parameters, initial }) });
@@ -33,6 +35,8 @@ const STYLE = `
 .precision tr.has-left-out td { border-bottom: 0; }
 .precision tr.left-out td { text-align: left; font-size: .85rem; color: var(--muted, #5b6575); padding-top: 0; }
 .precision tr.left-out ul { margin: 0; padding-left: 1.2rem; }
+.precision tr.not-symplectic td { text-align: left; font-size: .85rem; color: var(--muted, #5b6575); padding-top: 0; }
+.precision .warnings p { margin: .3rem 0; padding: .3rem .6rem; border-left: 3px solid #e67700; }
 .precision table { width: 100%; max-width: 60rem; }
 @media (max-width: 600px) { .precision th, .precision td { padding: .2rem .25rem; } .precision table { font-size: .82rem; } }
 `;
@@ -116,6 +120,7 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
     el("div", { className: "plot", id: "precision-plot-energy" }));
   const table = el("table", { id: "precision-orders" });
   const longBox = el("div", { id: "precision-long" });
+  const warningsBox = el("div", { className: "warnings", id: "precision-warnings" });
   const label = (text, input) => el("label", {}, text, input);
   root.append(
     el("h2", { id: "h-precision", textContent: "Work–precision" }),
@@ -126,9 +131,9 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
         label("step from (s)", stepFrom), label("step to (s)", stepTo),
         label("tolerance from", tolFrom), label("tolerance to", tolTo),
         label("points", count), label("t_end (s)", tEnd),
-        el("label", { className: "inline" }, longRun, " long run: symplectic Euler vs RK4, 1000 periods"),
+        el("label", { className: "inline" }, longRun, " long run: symplectic Euler vs RK4, up to 1000 periods"),
         runButton)),
-    status, plots, el("div", { className: "table-scroll" }, table), longBox);
+    status, warningsBox, plots, el("div", { className: "table-scroll" }, table), longBox);
   container.append(root);
 
   getJSON("/api/v1/methods").then((methods) => {
@@ -158,9 +163,11 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
     status.className = "status muted";
     status.textContent = "Running…";
     root.dataset.state = "running";
+    warningsBox.replaceChildren();
     try {
       const result = await postJSON("/api/v1/precision", body);
       showTable(result);
+      warningsBox.replaceChildren(...(result.warnings || []).map((w) => el("p", { textContent: w })));
       const ends = result.stopped ? ` The motion ends at t = ${num(result.stopped.t)} s (${result.stopped.message}): every run is compared up to there.` : "";
       status.textContent = `Done in ${num(result.seconds)} s${result.cut ? " — the time budget ran out: later points were cut short" : ""}.${ends}`;
       await loadPlotly().then(() => draw(result)).catch(() => {});
@@ -187,16 +194,28 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
           el("td", { textContent: `${m.points_in_fit} of ${m.points.length}` }),
           el("td", { textContent: m.fitted_against }));
         row.dataset.method = m.method;
+        const rows = [row];
+        if (m.not_symplectic) { // a method symplectic where M is constant, but not on this motion
+          row.className = "has-left-out";
+          const note = el("tr", { className: "not-symplectic" },
+            el("td", { colSpan: heads.length, textContent: `not symplectic here: ${m.not_symplectic}.` }));
+          note.dataset.noteOf = m.method;
+          rows.push(note);
+        }
         const lines = leftOutLines(m);
-        if (!lines.length) return [row];
+        if (!lines.length) return rows;
         row.className = "has-left-out";
         const cell = el("td", { colSpan: heads.length },
           el("ul", {}, ...lines.map((text) => el("li", { textContent: text }))));
         const why = el("tr", { className: "left-out" }, cell);
         why.dataset.leftOutOf = m.method; // not data-method: that names the rows of orders
-        return [row, why];
+        return [...rows, why];
       }));
-    if (!result.long_run) { longBox.replaceChildren(); return; }
+    if (!result.long_run) {
+      longBox.replaceChildren(...(result.long_run_declined
+        ? [el("h3", { textContent: "Long run" }), el("p", { textContent: result.long_run_declined })] : []));
+      return;
+    }
     const lr = result.long_run;
     const line = (name) => {
       const r = lr.runs[name];
@@ -206,10 +225,11 @@ export function mountPrecision(container, { sceneId = null, spec = null, getStat
     longBox.replaceChildren(
       el("h3", { textContent: `Long run: ${lr.periods} periods at h = ${num(lr.h)} s (period ${num(lr.period)} s, from ${lr.period_from})` }),
       el("p", { textContent: `${line("symplectic_euler")}; ${line("rk4")}.` }),
-      // stepping (q, q̇), symplectic Euler is symplectic only where the mass matrix is constant
-      ...(lr.symplectic_here === false ? [el("p", { className: "muted", textContent:
-        "Here the mass matrix changes with the coordinates, so symplectic Euler (which steps q and q̇, "
-        + "not the momenta) is not symplectic: its energy error is not bound to stay bounded." })] : []),
+      // the claim only where it holds (the API's one rule), and why not elsewhere
+      el("p", { className: "muted", textContent: lr.symplectic_here
+        ? "This motion is conservative and autonomous with a constant mass matrix: symplectic Euler "
+          + "conserves a modified energy exactly, so its energy error stays bounded, while RK4's drifts one way."
+        : `No bounded energy error is to be expected here: ${lr.not_symplectic}.` }),
       el("div", { className: "plot", id: "precision-plot-long" }));
   }
 
