@@ -1393,7 +1393,12 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
         return Power("dissipative" if dampers else "none", symbol=symbol)
     at = sp.expand(power.xreplace(values)) if power != 0 else power
     # gyroscopic: Q ≠ 0 with q̇, but Σ Q_j q̇_j = 0 (case by case where |q̇| or sign(q̇) appear)
-    if at == 0 or _once(d, "vanishes", at, lambda: vanishes(at, m)):
+    # exact with the parameters as symbols; with their values (c = 0) floats may leave 1e-17
+    if (
+        at == 0
+        or _once(d, "vanishes", "", lambda: vanishes(power, m))
+        or _once(d, "vanishes", at, lambda: vanishes(at, m))
+    ):
         return Power("dissipative" if dampers else "no work", symbol=symbol)
     proven = _once(d, "never positive", at, lambda: _never_positive(m, at))
     text = f"${symbol} = {_once(d, 'power latex', '', lambda: to_latex(power))}$"

@@ -38,6 +38,7 @@ NO_WORK = [
     "c*(sign(x_dot)*abs(x_dot) - x_dot)",
     "c*(x_dot*sign(x_dot) - abs(x_dot))",
     "c*(sign(x_dot - y_dot)*abs(x_dot - y_dot) - x_dot + y_dot)",
+    "c*(sign(x_dot/3 - c*y_dot)*abs(x_dot/3 - c*y_dot) - x_dot/3 + c*y_dot)",
     "c*(sign(x_dot*y_dot)*abs(x_dot*y_dot) - x_dot*y_dot)",
     "c*sign(x)*(abs(x_dot) - x_dot*sign(x_dot))",
 ]
@@ -271,15 +272,19 @@ def scene_ids_of_catalog() -> list[str]:
 
 
 @pytest.mark.parametrize("scene_id", scene_ids_of_catalog())
-def test_newton_names_each_force_as_the_free_body_diagram_of_the_same_scene(client, scene_id):
+def test_newton_names_each_force_as_the_free_body_diagram_of_the_same_scene(
+    client, scene_id, monkeypatch
+):
     """Body by body, /newton's ``forces`` are the diagram's (its ``fbd`` step from /derive): the
     same labels and kinds in the same order, constraint forces under the diagram's names; an
     applied force is F_g for a weight and F_<name> / M_<name> by the spec's own name of the spring,
     damper, force or torque (read from the spec, not from a label). The fields that were there
     stay (additive only)."""
+    monkeypatch.setenv("LAGRANGE_LAB_DERIVE_SECONDS", "120")  # a cold double pendulum on a
+    # loaded 2-core machine: the time budget is not what this test is about
     newton = client.post("/api/v1/newton", json={"scene_id": scene_id})
     derive = client.post("/api/v1/derive", json={"scene_id": scene_id})
-    assert newton.status_code == derive.status_code == 200
+    assert newton.status_code == derive.status_code == 200, (newton.text, derive.text)
     out = newton.json()
     assert {"steps", "constraint_forces", "equations", "agrees_with_lagrange"} <= set(out)
     fbd = next(s for s in derive.json()["steps"] if s["id"] == "fbd")["data"]["bodies"]

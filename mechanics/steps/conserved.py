@@ -49,6 +49,8 @@ def vanishes(power: sp.Expr, model: Model) -> bool:
     not linear in any of its symbols with a numeric slope) no claim is made."""
     if power == 0:
         return True
+    if not power.has(sp.Abs, sp.sign):  # the caller's simplification was the whole test
+        return False
     to_sym, _ = _symbols_for(model)
     e = power.xreplace(to_sym).xreplace({t: sp.Symbol("_t", real=True)})
     return _zero_by_cases(e, MAX_SIGN_SPLITS)
@@ -63,7 +65,7 @@ def _zero_by_cases(e: sp.Expr, splits: int) -> bool:
         return e == 0 or _tidy_symbols(e, (), True)[0] == 0
     if splits == 0:
         return False
-    for kink in kinks:
+    for kink in sorted(kinks, key=sp.default_sort_key):  # one order, one verdict, every run
         u = kink.args[0]
         if u.has(sp.Abs, sp.sign) or u.is_real is not True:  # |u| of a complex u is not ±u
             continue
@@ -102,14 +104,19 @@ def _factor_kinks(e: sp.Expr) -> sp.Expr:
 
 def _as_variable(u: sp.Expr) -> tuple[sp.Symbol, sp.Expr, sp.Expr] | None:
     """u = slope·v + rest with slope a nonzero number and rest free of v, or None: then
-    v ↦ u is a bijection of the reals and u can stand for v (the other symbols held)."""
+    v ↦ u is a bijection of the reals and u can stand for v (the other symbols held). A slope
+    of ±1, then a rational one, is preferred: a float's reciprocal does not cancel exactly."""
+    found = []
     for v in sorted(u.free_symbols, key=str):
         slope = u.diff(v)
         if slope.is_number and slope != 0:
             rest = sp.expand(u - slope * v)
             if not rest.has(v):
-                return v, rest, slope
-    return None
+                found.append((abs(slope) != 1, not slope.is_Rational, v, rest, slope))
+    if not found:
+        return None
+    *_, v, rest, slope = min(found, key=lambda f: f[:2])
+    return v, rest, slope
 
 
 def conserved_quantities(model: Model, work: Work) -> Step:
