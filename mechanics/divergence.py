@@ -214,6 +214,7 @@ def compare_runs(
         float(span[worst]),
         n_dof=n - len(c.momenta),
         autonomous=is_autonomous(c.rhs(params), t, y),
+        cyclic=tuple(c.momenta),
         name=c.coordinates[worst],
         tolerances=tolerances,
         time_shift=best_time_shift(t, y[:, worst], y_other[:, worst]),
@@ -318,6 +319,7 @@ def classify_divergence(
     name: str = "the coordinate",
     tolerances: tuple[float, float] | None = None,
     time_shift: TimeShift | None = None,
+    cyclic: tuple[str, ...] = (),
 ) -> Divergence:
     """Classify how |diff| (two runs' difference in one coordinate) grows along the run.
 
@@ -325,7 +327,8 @@ def classify_divergence(
     it), ``n_dof`` the degrees of freedom left after cyclic coordinates, ``autonomous`` whether
     the equations are free of explicit t. ``tolerances`` (this run's rtol, the looser one) and
     ``time_shift`` (`best_time_shift` of the two runs) only enrich the message: with a time
-    shift a drift is told as timing only where a shift undoes it.
+    shift a drift is told as timing only where a shift undoes it. ``cyclic`` names the cyclic
+    coordinates n_dof left out, so the sentence counts the coordinates as the scene has them.
     """
     t = np.asarray(t, dtype=float)
     d = np.abs(np.asarray(diff, dtype=float)) / max(float(span), 1e-300)
@@ -375,6 +378,8 @@ def classify_divergence(
             timing,
             checked=time_shift is not None,
             forced=forced,
+            cyclic=cyclic,
+            n_dof=n_dof,
         )
         return Divergence(
             kind,
@@ -417,6 +422,24 @@ class Drift:
     timing: TimeShift | None  # when a time shift undoes most of the difference
     checked: bool  # whether a time shift was tried at all
     forced: bool  # classified by the prior (chaos impossible), not by the fit
+    cyclic: tuple[str, ...] = ()  # cyclic coordinates set aside (their momenta conserved)
+    n_dof: int = 1  # the coordinates left
+
+
+def _phase_plane(drift: Drift) -> str:
+    """Why chaos is impossible, counting the coordinates as the scene has them: the spherical
+    pendulum has two, θ and the cyclic φ, and was told it had "one coordinate"."""
+    if not drift.cyclic:
+        return "there is one coordinate and no explicit time (a phase plane)"
+    names = ", ".join(drift.cyclic)
+    verb = "is" if len(drift.cyclic) == 1 else "are"
+    its = "its momentum" if len(drift.cyclic) == 1 else "their momenta"
+    if drift.n_dof < 1:
+        return f"{names} {verb} cyclic ({its} conserved) and there is no explicit time"
+    return (
+        f"{names} {verb} cyclic ({its} conserved), which leaves one coordinate and no "
+        "explicit time (a phase plane)"
+    )
 
 
 def _drift(drift: Drift, name: str, tolerances) -> str:
@@ -433,9 +456,9 @@ def _drift(drift: Drift, name: str, tolerances) -> str:
     growth = "" if p is None else " linearly" if 0.7 <= p <= 1.3 else f" like t^{p:.1f}"
     if drift.forced:
         text = (
-            f"The runs{_tol(tolerances)} drift apart in phase: with one coordinate and no "
-            "explicit time (a phase plane) errors cannot keep growing exponentially (they may "
-            "grow fast for a while, near the top of a swing, but not for good)."
+            f"The runs{_tol(tolerances)} drift apart in phase: {_phase_plane(drift)}, so "
+            "errors cannot keep growing exponentially (they may grow fast for a while, near "
+            "the top of a swing, but not for good)."
         )
     else:
         text = f"The runs{_tol(tolerances)} drift apart steadily in phase, not exponentially."

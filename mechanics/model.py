@@ -386,6 +386,7 @@ def build_model(spec: SceneSpec | dict, branches: dict[int, int] | None = None) 
                     kind="anchor",
                 )
             )
+    stops += _anchor_stops_at_run_values(springs, positions, N, q)
     stops += _domain_stops(differentiated, spec, names)
     for name, qi in zip(spec.coordinates, q, strict=True):
         if name in spec.positive_coordinates:
@@ -626,6 +627,43 @@ def _inertia_errors(where: str, what: str, entries: dict[str, float | None]) -> 
             }
         ]
     return []
+
+
+def _anchor_stops_at_run_values(
+    springs: list[SpringInfo], positions: dict[str, Vector], N: ReferenceFrame, q: list
+) -> list[StopInfo]:
+    """The anchor stop of a spring that is along a line only at some parameter values: d = (x, h)
+    is no perfect square, so no branch stop was made, yet at h = 0 the run's ℓ = |x| reaches 0,
+    where V has the same corner. One stop per component d_i that moves: its sign change, where
+    every other component is exactly 0 (the guard −Σ d_j² ≥ 0), is ℓ reaching 0. A body passing
+    near the anchor but not through it (d_j ≠ 0) does not stop; one moving on the line does.
+    """
+    out = []
+    for s in springs:
+        rooted = any(p.exp == sp.S.Half for p in s.length.atoms(sp.Pow))
+        if s.branch is not None or s.rest_length.is_zero or not rooted:
+            continue  # along a line in the spec itself (a branch stop), smooth, or never 0
+        d = positions[s.b] - positions[s.a]
+        parts = [sp.expand(d.dot(u)) for u in (N.x, N.y, N.z)]
+        parts = [c for c in parts if c != 0]
+        if any(c.is_number for c in parts):
+            continue  # a constant nonzero offset: ℓ never reaches 0
+        for i, c in enumerate(parts):
+            if not c.has(T, *q):
+                continue
+            others = sum((o**2 for j, o in enumerate(parts) if j != i), sp.S.Zero)
+            out.append(
+                StopInfo(
+                    f"{s.name}_at_anchor",
+                    f"the spring {s.name} reaches zero length: its direction is undefined "
+                    "there (V = ½k(|d| − ℓ₀)² has a corner), so the model ends",
+                    _corner_only_if_stretched(c, s.rest_length),
+                    crossing="any",
+                    only_if=-others,
+                    kind="anchor",
+                )
+            )
+    return out
 
 
 def _corner_only_if_stretched(branch: sp.Expr, rest_length: sp.Expr) -> sp.Expr:

@@ -19,6 +19,7 @@ from sympy.physics.vector import Vector
 
 from mechanics import native
 from mechanics.derive import Derivation, derivation_of_scene, derivation_of_spec, spec_text
+from mechanics.model import StopInfo
 from mechanics.model import T as t
 from mechanics.spec import SpecError
 from mechanics.steps import partial
@@ -174,8 +175,73 @@ def _args(d: Derivation) -> tuple[list, dict]:
 
 
 def _plain(expr: Any, subs: dict) -> Any:
-    """q(t), q̇(t), t -> plain symbols: derivatives first, so q̇ is not read as d/dt of a number."""
-    return expr.xreplace(subs) if isinstance(expr, sp.Basic) else sp.Float(expr)
+    """q(t), q̇(t), t -> plain symbols: derivatives first, so q̇ is not read as d/dt of a number.
+
+    δ(u) -> 0: sympy's d sign(u)/du = 2δ(u) has no numeric twin in Python, numpy or C, and is 0
+    wherever u ≠ 0; `refuse_impulses` has already refused the scenes where δ carries weight (a
+    potential that jumps), so only the terms that vanish on u = 0 (u δ(u), from u·sign(u)) reach
+    here."""
+    if not isinstance(expr, sp.Basic):
+        return sp.Float(expr)
+    out = expr.xreplace(subs)
+    return out.replace(sp.DiracDelta, lambda *_: sp.S.Zero) if out.has(sp.DiracDelta) else out
+
+
+def _vanishes_where_zero(coefficient: sp.Expr, u: sp.Expr) -> bool:
+    """True when ``coefficient`` is 0 wherever u = 0 (so coefficient·δ(u) = 0 as a force).
+    Decided only for u of degree ≤ 2 in one of its symbols; anything else counts as weight."""
+    for s in sorted(u.free_symbols, key=str):
+        try:
+            poly = sp.Poly(u, s)
+        except sp.PolynomialError:
+            continue
+        if not 1 <= poly.degree() <= 2 or poly.has(sp.DiracDelta):
+            continue
+        roots = sp.solve(u, s)
+        return bool(roots) and all(sp.simplify(coefficient.xreplace({s: r})) == 0 for r in roots)
+    return False
+
+
+def refuse_impulses(d: Derivation, exprs: list) -> None:
+    """A potential that jumps (k·sign(x)) makes its force an impulse 2kδ(x): no integrator
+    follows it (δ is 0 at every step it samples, so the particle would cross the step as if it
+    were not there and V would jump). Refused naming the potential; u·sign(u) = |u| is smooth
+    enough (its δ term u δ(u) is 0) and passes."""
+    z = sp.Dummy("z")
+    for e in exprs:
+        if isinstance(e, sp.Basic) and e.has(sp.Derivative):
+            e = e.doit()  # ∂/∂t sign(t − 1) stays unevaluated in sympy: 2δ(t − 1)
+            if e.has(sp.Derivative):
+                raise SpecError([_impulse_error(d, None)])
+        if not isinstance(e, sp.Basic) or not e.has(sp.DiracDelta):
+            continue
+        for delta in e.atoms(sp.DiracDelta):
+            u = delta.args[0]
+            ordinary = len(delta.args) == 1 or delta.args[1] == 0
+            weight = sp.diff(e.xreplace({delta: z}), z)
+            if ordinary and _vanishes_where_zero(weight, u):
+                continue
+            raise SpecError([_impulse_error(d, u)])
+
+
+def _impulse_error(d: Derivation, u: sp.Expr | None) -> dict[str, str]:
+    m = d.model
+    args, _ = _args(d)
+    names = [sp.Symbol("t"), *(sp.Symbol(c) for c in m.coordinate_names)]
+    where = (
+        ""
+        if u is None
+        else f" where {sp.sstr(u.xreplace(dict(zip(args, names, strict=False))))} = 0"
+    )
+    fields = [
+        f"potentials[{i}].expression" for i, (_, v) in enumerate(m.potentials) if v.has(sp.sign)
+    ]
+    return {
+        "field": ", ".join(fields) or "potentials",
+        "message": f"this potential jumps{where} (sign() of a coordinate or of t, not multiplied "
+        "by something that vanishes there): its force is an impulse at the jump, which no "
+        "integrator can follow; write it without the jump (abs(x) and x*sign(x) are continuous)",
+    }
 
 
 def compile_derivation(d: Derivation) -> CompiledScene:
@@ -199,6 +265,8 @@ def compile_derivation(d: Derivation) -> CompiledScene:
     if drive == 0 and len(rates) == 1:
         drive = None
     solved = w.accelerations is not None
+    equations = list(w.accelerations) if solved else [*w.mass_matrix, *w.forcing]
+    refuse_impulses(d, [e.xreplace(subs) for e in [*equations, *rates] if isinstance(e, sp.Basic)])
     native_inputs = {"args": args, "n": len(m.q), "power": [_plain(r, subs) for r in rates]}
     if solved:
         native_inputs["accelerations"] = [_plain(e, subs) for e in w.accelerations]
@@ -263,8 +331,83 @@ def compile_derivation(d: Derivation) -> CompiledScene:
         branch_values={
             i: vector([s.branch]) for i, s in enumerate(m.springs) if s.branch is not None
         },
-        stop_specs=list(m.stops),
+        stop_specs=[*m.stops, *sticking_stops(d)],
     )
+
+
+def velocity_jumps(d: Derivation) -> list[sp.Expr]:
+    """The arguments u of sign(u) in the equations of motion that hold a velocity (Coulomb
+    friction −μ m g sign(ẋ)): where u = 0 the force jumps, and the equations' sign(0) = 0 is
+    a model of sliding only."""
+    m, w = d.model, d.work
+    exprs = list(w.accelerations) if w.accelerations is not None else list(w.forcing)
+    found: list[sp.Expr] = []
+    for e in exprs:
+        if not isinstance(e, sp.Basic):
+            continue
+        for atom in e.atoms(sp.sign):
+            u = atom.args[0]
+            if u.has(*m.qd) and u not in found:
+                found.append(u)
+    return found
+
+
+def sticking_stops(d: Derivation) -> list[StopInfo]:
+    """Implicit stops where a sliding contact sticks: u (a velocity inside sign(u)) reaches 0
+    while the other forces cannot overcome the friction, that is while u̇ computed with
+    sign(u) = +1 is ≤ 0 and with sign(u) = −1 is ≥ 0 (each side pushes back to u = 0).
+
+    There the equations (sign(0) = 0) no longer describe the contact: an integrator chatters
+    across u = 0 in ever smaller steps (DOP853 crawled to t = 3e-5 s, Radau to 2e-11 s, in 10 s
+    of server time) and what it shows is no motion. Only for equations solved for q̈, and not
+    where the spec declares a sign-change stop of its own (the block on the incline does)."""
+    m, w = d.model, d.work
+    if w.accelerations is None or any(st.crossing == "any" for st in m.stops):
+        return []
+    out = []
+    for u in velocity_jumps(d):
+        rate = u.diff(t)
+        sides = []
+        for side in (1, -1):
+            qdd = [a.xreplace({sp.sign(u): side}) for a in w.accelerations]
+            sides.append(rate.xreplace(dict(zip(m.qdd, qdd, strict=True))))
+        if any(s.has(sp.Derivative) for s in sides):
+            continue
+        text = sp.sstr(_plain(u, _user_names(d)))
+        out.append(
+            StopInfo(
+                f"sticks_{text}",
+                f"{text} reaches 0 where the other forces cannot overcome the friction "
+                f"(sign({text}) jumps there): the contact sticks, and the equations, read with "
+                "sign(0) = 0, describe it only while it slides, so the model ends",
+                u,
+                crossing="any",
+                only_if=sp.Min(-sides[0], sides[1]),
+                kind="sticks",
+            )
+        )
+    return out
+
+
+def velocity_jump_functions(c: CompiledScene) -> list[tuple[str, Any]]:
+    """(u as the spec writes it, u(t, q, q̇, p) for scalars) for each sign(u) of a velocity in
+    the equations: where a run starting at u = 0 sits on the jump."""
+    cached = getattr(c, "_velocity_jumps", None)
+    if cached is None:
+        args, subs = _args(c.derivation)
+        cached = [
+            (sp.sstr(_plain(u, _user_names(c.derivation))), sp.lambdify(args, _plain(u, subs)))
+            for u in velocity_jumps(c.derivation)
+        ]
+        c._velocity_jumps = cached
+    return cached
+
+
+def _user_names(d: Derivation) -> dict:
+    """q(t), q̇(t) -> the names the spec uses (x, x_dot), for a message."""
+    m = d.model
+    names = {qd: sp.Symbol(f"{c}_dot") for qd, c in zip(m.qd, m.coordinate_names, strict=True)}
+    return names | {q: sp.Symbol(c) for q, c in zip(m.q, m.coordinate_names, strict=True)}
 
 
 def constraint_force_functions(c: CompiledScene) -> dict[str, tuple[Any, Any | None]]:

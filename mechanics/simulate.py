@@ -31,6 +31,7 @@ from mechanics.numeric import (
     constraint_force_functions,
     evaluate,
     overflow_error,
+    velocity_jump_functions,
 )
 from mechanics.spec import SpecError
 from mechanics.stops import (
@@ -446,6 +447,8 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     run = _run(c, params, y0, t_eval[:1] if at_start else t_eval, req, req.rtol, req.atol)
     warnings: list[str] = [run.note] if run.note else []
     warnings += _where_samples_end(req, t_eval)
+    if at_start is None:
+        warnings += _implicit_on_a_jump(c, params, y0, req)
     raw = run
     if at_start is not None:
         run.status, run.message = "stopped", f"{at_start.name} at t = 0 s"
@@ -459,11 +462,12 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     values = dict(zip(c.parameters, params, strict=True))
     n = c.n
     t_seen, y_seen = run.t, run.y
-    if run.status != "ok" and run.y_reached is not None and math.isfinite(run.t_reached):
+    reached = _state_reached(c, params, req, run) if run.status != "ok" else None
+    if reached is not None:
         # a failed run's last step lies past its last sample: a mass "m (1 − t/2)" reaches 0
         # at the failure (t = 2 s) and at no sample before it
         t_seen = np.append(run.t, run.t_reached)
-        y_seen = np.vstack([run.y, np.asarray(run.y_reached)[None, : run.y.shape[1]]])
+        y_seen = np.vstack([run.y, reached[None, : run.y.shape[1]]])
     unphysical = limits_along_run(
         c.derivation.model, values, t_seen, y_seen[:, :n].T, y_seen[:, n : 2 * n].T
     )
@@ -532,14 +536,15 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
             float(np.max(np.abs(p[:measured]))), 1e-300
         )
     stats["momentum_drift"] = drift
+    noise = roundoff(c, t, q, qd, params, T, [w_nc, w_drive])[:measured]
     if "energy" in conserved:
-        said = _accuracy_warning(req, "E", E - E[0], E[0], T, t, qd, c, measured)
+        said = _accuracy_warning(req, "E", E - E[0], E[0], T, t, qd, c, measured, noise)
     elif c.jacobi is not None:
         said = _accuracy_warning(
-            req, "The Jacobi integral h", h - h[0], h[0], T, t, qd, c, measured
+            req, "The Jacobi integral h", h - h[0], h[0], T, t, qd, c, measured, noise
         )
     else:
-        said = _accuracy_warning(req, _BALANCE, balance, None, T, t, qd, c, measured)
+        said = _accuracy_warning(req, _BALANCE, balance, None, T, t, qd, c, measured, noise)
     warnings += [said] if said else []
     warnings += _singularity_warnings(c, t, q, qd, params)
     if req.check_sensitivity and METHODS[req.method].kind == "adaptive" and raw.status == "ok":
@@ -591,6 +596,28 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
 
 _BALANCE = "The energy balance ΔT + ΔV − W_NC − W_drive (0 for an exact run)"
 
+#: Units in the last place that evaluating T + V (and the work terms) may cost: the energy of a
+#: sample is a sum of terms each rounded to its own size, so its error is a few ulps of the
+#: largest term, not of the sum. A pendulum of m = 1000 kg swinging by 1e-7 rad has |V| = 9810 J
+#: and T ≤ 5e-11 J: one ulp of V (1.8e-12 J) is 3.7 % of T, and no tolerance can shrink it.
+ROUNDOFF_ULPS = 4
+#: An error within this many times the round-off floor may be half round-off or more: advice to
+#: tighten the tolerance (or shorten the step) would promise more than it can give.
+ROUNDOFF_SHARE = 2
+
+
+def roundoff(c: CompiledScene, t, q, qd, params, T: np.ndarray, work: list) -> np.ndarray:
+    """The error floating point alone puts into each sample's T + V (− W): ROUNDOFF_ULPS ulps of
+    the sum of the terms' sizes, |T| + Σ|V_part| (+ |W|), since a large V that cancels (a mass
+    hung 1000 m above the datum) is rounded at its own size before the cancellation."""
+    size = np.abs(T)
+    for fn in c.potential_parts.values():
+        (part,) = evaluate(fn, t, q, qd, params)
+        size = size + np.abs(part)
+    for w in work:
+        size = size + np.abs(w)
+    return ROUNDOFF_ULPS * np.finfo(float).eps * size
+
 
 def _accuracy_warning(
     req: SimulationRequest,
@@ -602,6 +629,7 @@ def _accuracy_warning(
     qd: np.ndarray,
     c: CompiledScene,
     measured: int,
+    noise: np.ndarray | None = None,
 ) -> str | None:
     """The sentence on a run whose conserved quantity (or energy balance) strayed by more than
     ENERGY_WARNING, true to what the error did: a symplectic method's error oscillates and stays
@@ -609,9 +637,15 @@ def _accuracy_warning(
     explicit one's grows with time; advice that fits one is wrong for the other.
 
     ``error`` is the signed error at each sample (Q − Q0, or the balance residual), ``start``
-    is Q0 (None for the balance, whose exact value is 0)."""
+    is Q0 (None for the balance, whose exact value is 0); ``noise`` the round-off floor of each
+    sample (`roundoff`): an error within the floor of its sample and of the start is no
+    integration error and no tolerance or step shrinks it, so it is not warned about, and where
+    round-off is a sizeable share of the error the advice says so instead of promising a cure."""
     error, T, t, qd = error[:measured], T[:measured], t[:measured], qd[:, :measured]
     if len(error) == 0 or not (np.all(np.isfinite(error)) and np.all(np.isfinite(T))):
+        return None
+    floor = np.zeros_like(error) if noise is None else noise[: len(error)] + noise[0]
+    if np.all(np.abs(error) <= floor):
         return None
     # Sized against the kinetic energy each sample would have had were the quantity exact,
     # T − error (E0 − V where E is conserved): the error cannot inflate it. The largest T of
@@ -628,6 +662,14 @@ def _accuracy_warning(
     shrink = "a smaller step" if fixed else "a tighter rtol/atol"
     share = f"{100 * size:.2g}% of" if size < 1 else f"{size:.2g} times"
     of_scale = f"{share} the motion's kinetic-energy scale ({scale:.3g}{unit})"
+    largest_floor = float(np.max(floor))
+    if abs(float(error[worst])) < ROUNDOFF_SHARE * largest_floor:
+        return (
+            f"{name} strays by up to {abs(float(error[worst])):.3g}{unit}, {of_scale}; "
+            f"floating-point round-off of the sum T + V alone can reach "
+            f"{largest_floor:.2g}{unit} (its terms are far larger than the motion's energy), "
+            f"so {shrink} would not remove much of it."
+        )
     trend = _error_trend(error, qd)
     if trend == "bounded":
         lo, hi = float(np.min(error)), float(np.max(error))
@@ -849,6 +891,18 @@ def _why_it_stopped(c: CompiledScene, params: list[float], req: Any, run: Trajec
             "method (DOP853), which shrinks its steps where the motion is fast and tells the two "
             "apart."
         ]
+    jumps = [u for u, _ in velocity_jump_functions(c)]
+    held_down = any(w in text for w in ("wall-time", "budget", "step size", "too small"))
+    if jumps and held_down:
+        u = jumps[0]
+        return [
+            f"The steps were held down at a jump of the equations, not by stiffness: sign({u}) "
+            f"changes the force at once where {u} = 0 (friction reversing). Where the other "
+            "forces cannot overcome the friction the contact sticks, and the equations, read "
+            "with sign(0) = 0, describe it only while it slides: the steps chatter across "
+            f'{u} = 0. Declare a stop on {u} (crossing "any", with only_if the condition for '
+            "sliding on) to end the run where it sticks; Radau or BDF do not help."
+        ]
     # out of wall time, a growing state may be a resonance still climbing, not a blow-up
     growth = None if "wall-time" in text else _growth(c, params, req, run)
     if growth is not None:
@@ -885,28 +939,67 @@ def _why_it_stopped(c: CompiledScene, params: list[float], req: Any, run: Trajec
     return []
 
 
+#: Methods whose Newton iterations use a finite-difference Jacobian from the first step: across
+#: sign(ẋ) at ẋ = 0 it reads the jump as an enormous damping (LSODA starts explicit and switches
+#: only when it finds the problem stiff: it slid correctly where these two crept or ran off).
+_NEWTON_FROM_THE_START = ("Radau", "BDF")
+
+
+def _implicit_on_a_jump(c: CompiledScene, params: list[float], y0: np.ndarray, req) -> list[str]:
+    """A run by Radau or BDF that starts at u = 0 of a sign(u) of a velocity (a block released
+    from rest against Coulomb friction): Radau crept (x from 5 to 4.97 in 10 s where the block
+    slides to 0.886 by t = π), BDF ran off to x = −245. Said, with the methods that do not."""
+    if req.method not in _NEWTON_FROM_THE_START:
+        return []
+    n = c.n
+    out = []
+    for text, fn in velocity_jump_functions(c):
+        try:
+            value = float(fn(0.0, *y0[:n].tolist(), *y0[n : 2 * n].tolist(), *params))
+        except (ValueError, ZeroDivisionError, OverflowError):
+            continue
+        if value == 0:
+            out.append(
+                f"The run starts at {text} = 0, where sign({text}) (the friction) jumps: "
+                f"{req.method}'s Newton iterations straddle the jump, and their finite-"
+                "difference Jacobian reads it as an enormous damping, so the motion shown may "
+                "creep or run off instead of sliding. Run it with an explicit method (DOP853, "
+                "RK45) or LSODA."
+            )
+    return out
+
+
+def _state_reached(c: CompiledScene, params: list[float], req: Any, run: Trajectory):
+    """The state where a failed run's stepping stopped (past its last sample), or None. The C
+    loop keeps no state past its last sample: the stretch from there is stepped again (scipy's
+    DOP853), so a limit reached there (a mass m (1 − t) at t = 1) is seen by every method."""
+    if run.y_reached is not None:
+        return np.asarray(run.y_reached, dtype=float) if math.isfinite(run.t_reached) else None
+    t_last, reached = float(run.t[-1]), run.t_reached
+    if not (math.isfinite(reached) and reached > t_last):
+        return None
+    try:
+        again = integrate(
+            c.rhs(params),
+            run.y[-1],
+            np.array([t_last, reached]),
+            method="DOP853",
+            rtol=req.rtol,
+            atol=req.atol,
+            max_wall_time=1.0,
+            second_order=c.n,
+        )
+    except (ValueError, *_PHYSICAL):
+        return None
+    return None if again.y_reached is None else np.asarray(again.y_reached, dtype=float)
+
+
 def _growth(c: CompiledScene, params: list[float], req: Any, run: Trajectory):
     """(|T| + |V| before, at the stop) when it grew BLOW_UP_GROWTH-fold from the first half of
-    the run to where the stepping stopped; else None. The C loop keeps no state past its
-    last sample: the stretch from there to the stop is stepped again (scipy's DOP853)."""
+    the run to where the stepping stopped; else None."""
     n2 = 2 * c.n
-    end = run.y_reached
     t_last, reached = float(run.t[-1]), run.t_reached
-    if end is None and math.isfinite(reached) and reached > t_last:
-        try:
-            again = integrate(
-                c.rhs(params),
-                run.y[-1],
-                np.array([t_last, reached]),
-                method="DOP853",
-                rtol=req.rtol,
-                atol=req.atol,
-                max_wall_time=1.0,
-                second_order=c.n,
-            )
-            end = again.y_reached
-        except (ValueError, *_PHYSICAL):
-            end = None
+    end = _state_reached(c, params, req, run)
     end = np.asarray(run.y[-1] if end is None else end, dtype=float)
     early = run.t <= (reached if math.isfinite(reached) else t_last) / 2
 
