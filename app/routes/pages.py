@@ -18,7 +18,7 @@ from fastapi.responses import HTMLResponse
 from fastapi.templating import Jinja2Templates
 
 from app import derivations
-from app.paths import TEMPLATES_DIR, mathjax_dir
+from app.paths import STATIC_DIR, TEMPLATES_DIR, mathjax_dir
 from mechanics.scenes import list_scenes, scene_ids
 
 router = APIRouter(include_in_schema=False)
@@ -126,7 +126,18 @@ async def scene_page(request: Request, scene_id: str) -> HTMLResponse:
         inline_derivation=derivation,
         inline_live=live,
         live_module=module,
+        prerendered_math=_prerendered_math(request, scene_id),
     )
+
+
+def _prerendered_math(request: Request, scene_id: str) -> str | None:
+    """The URL of the scene's derivation typeset ahead of time (``python -m app.prerender``), if
+    the package has it: the page puts those equations up as they are instead of typesetting them
+    (static/js/prerendered.js). Cached a year like every asset; a derivation changed since
+    misses in it and is typeset live."""
+    if mathjax_dir() is None or not (STATIC_DIR / "math" / f"{scene_id}.json").is_file():
+        return None
+    return request.app.state.assets.url(f"math/{scene_id}.json")
 
 
 def _spec_json(scene_id: str) -> bytes:

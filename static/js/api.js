@@ -3,6 +3,8 @@
 // when it has settled; whatever takes longer than SLOW_MS (a request, the math being typeset)
 // shows a progress bar at the top of the page, saying what it waits for (`busy`).
 
+import { applyPrerendered, usePrerendered } from "./prerendered.js";
+
 export class ApiError extends Error {
   constructor(status, detail) {
     const text = Array.isArray(detail)
@@ -133,9 +135,21 @@ export function postJSON(url, payload, { signal } = {}) {
   });
 }
 
-/** Render the LaTeX inside `elements` with MathJax (pages without it keep the source). MathJax
- * may still be loading (a page can load it async, so it does not hold up the page's script). */
+/** Render the LaTeX inside `elements` with MathJax (pages without it keep the source): from the
+ * prerendered math where it has the formula (a built-in derivation, static/js/prerendered.js),
+ * else live. MathJax may still be loading (a page can load it async, so it does not hold up the
+ * page's script). */
 export async function typeset(elements) {
+  const left = applyPrerendered(elements);
+  if (left.length) await typesetLive(left);
+}
+
+/** Use the prerendered math at `url` for the derivation's steps (see prerendered.js). */
+export function prerenderedMath(url) {
+  return usePrerendered(url, typesetLive);
+}
+
+async function typesetLive(elements) {
   let mj = await mathJax();
   if (!mj) return;
   await mj.startup.promise;

@@ -7,7 +7,10 @@
 // moves, and lets a body be dragged to its starting place. The preview is labelled as such until
 // the server's run (the measured one, which the integrator panel, plots and compare mode show)
 // replaces it; the server is asked when a slider is let go.
-import { busy, getJSON, holdMathJax, postJSON, releaseMathJax, track, typeset } from "./api.js";
+import {
+  busy, getJSON, holdMathJax, postJSON, prerenderedMath, releaseMathJax, track, typeset,
+} from "./api.js";
+import { keepAnchor } from "./anchor.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
 import { renderSteps } from "./derivation.js";
 import { nameText } from "./texnames.js";
@@ -32,6 +35,8 @@ const DISPLAY_FACTOR = 2;
 const MATH_WAIT_MS = 600;
 /** The first plots wait for the math, at most this long (ms). */
 const PLOTS_WAIT_MS = 3000;
+/** The prerendered math (one file, fetched with the page) is waited for at most this long (ms). */
+const PRERENDERED_WAIT_MS = 1500;
 
 export async function mountScene({ sceneId = null, spec = null, derivation = null }) {
   const view = new SceneView(sceneId);
@@ -63,11 +68,15 @@ class SceneView {
     // Everything a built-in scene needs is asked for at once: the spec, the derivation and the
     // live equations do not wait for each other. The page usually carries them already
     // (templates/scene.html): then nothing waits for a round trip.
+    keepAnchor(); // a link to #h-derivation stays there while the page fills in above it
     const inline = this.sceneId ? inlineData() : {};
     let derived = derivation;
     this.motion = settleOnce(); // resolved once the canvas moves, or is known not to soon
     this.mathDone = settleOnce(); // resolved once the derivation is typeset (or failed)
     holdMathJax(this.motion);
+    // a built-in derivation's math, typeset ahead of time (prerendered.js), fetched meanwhile
+    const ready = document.querySelector("link[data-prerendered-math]");
+    this.prerendered = ready ? prerenderedMath(ready.href) : Promise.resolve();
     if (this.sceneId) {
       derived = derivation || inline.derivation || postJSON("/api/v1/derive", this.target());
       derived.catch?.(() => {}); // shown by derive(); not an unhandled rejection meanwhile
@@ -530,6 +539,8 @@ class SceneView {
       el.style.visibility = hide ? "hidden" : "";
     });
     if (window.MathJax) items.forEach((item) => raw(item, true));
+    // the ready-made math, unless its file is slow to come: then MathJax typesets it all
+    await Promise.race([this.prerendered, new Promise((resolve) => setTimeout(resolve, PRERENDERED_WAIT_MS))]);
     const done = busy("Typesetting the equations…");
     const view = watchInView(items);
     try {

@@ -71,3 +71,27 @@ def test_punctuation_stays_with_the_math_before_it(server, browser):
             assert bad == [], (width, bad)
         assert checked > 0  # the derivation has such sentences (the mass matrix's "f(q, q̇, t).")
         assert errors == []
+
+
+@pytest.mark.parametrize("scene", ["rolling_disk", "double_pendulum"])
+def test_a_link_to_the_derivation_stays_there_while_the_page_fills_in(server, browser, scene):
+    """The skip link's target, #h-derivation: the plots and panels above it arrive later and
+    pushed the heading a screen down (rolling disk, 1280×800). Once everything has arrived the
+    heading is still at the top, under the sticky header; a reader who scrolls is left alone."""
+    with projector(browser, 1280, 800) as (p, errors):
+        p.goto(f"{server}/scenes/{scene}#h-derivation")
+        open_lecture(p, p.url)
+        p.wait_for_function("() => document.querySelector('#plot-q .modebar-btn')", timeout=90_000)
+        p.wait_for_timeout(500)
+        top = p.evaluate("document.getElementById('h-derivation').getBoundingClientRect().top")
+        pad = p.evaluate("parseFloat(getComputedStyle(document.documentElement).scrollPaddingTop)")
+        header = p.evaluate("document.querySelector('body > header').offsetHeight")
+        assert header <= top <= pad + 40, (top, pad, header)
+        # the reader scrolls away: the page does not pull them back
+        p.mouse.wheel(0, 600)
+        p.wait_for_timeout(400)
+        p.evaluate("window.dispatchEvent(new Event('resize'))")
+        p.wait_for_timeout(400)
+        moved = p.evaluate("document.getElementById('h-derivation').getBoundingClientRect().top")
+        assert moved < top - 300
+        assert errors == []

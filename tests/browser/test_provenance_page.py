@@ -47,7 +47,9 @@ def test_trace_terms_tables_and_hover(server, page, artifacts):
     # f's table subtracts terms as −\left(…\right): the TeX MathJax was given has no carriage
     # return and no bare 'left(' (a template literal once turned '\r' of '\right' into one)
     broken = p.evaluate(
-        """() => Array.from(MathJax.startup.document.math).map((m) => m.math)
+        """() => [...Array.from(window.MathJax?.startup?.document?.math || []).map((m) => m.math),
+                  ...[...document.querySelectorAll('mjx-container[data-prerendered]')]
+                    .map((c) => c.dataset.tex)]
             .filter((tex) => /\\r|(?<!\\\\)left\\(/.test(tex))"""
     )
     assert broken == [], broken

@@ -16,8 +16,16 @@ pytestmark = pytest.mark.browser
 
 Q_BOX = "li[data-step='forces'] details.yourturn"
 
-#: The TeX sources MathJax typeset inside an element (what the room reads, as LaTeX).
-TEX_IN = """(el) => window.MathJax.startup.document.getMathItemsWithin(el).map((m) => m.math)"""
+#: The TeX sources typeset inside an element (what the room reads, as LaTeX): by MathJax on the
+#: page, or ahead of time (static/js/prerendered.js keeps each one's TeX in data-tex), in order.
+TEX_IN = """(el) => {
+  const doc = window.MathJax?.startup?.document;
+  const live = new Map((doc?.getMathItemsWithin ? doc.getMathItemsWithin(el) : [])
+    .map((m) => [m.typesetRoot, m.math]));
+  return [...el.querySelectorAll('mjx-container')]
+    .map((c) => (c.dataset.prerendered !== undefined ? c.dataset.tex : live.get(c)))
+    .filter((tex) => tex !== undefined);
+}"""
 
 
 def atwood_has_no_nonconservative_load(server: str) -> bool:
