@@ -341,14 +341,17 @@ def velocity_jumps(d: Derivation) -> list[sp.Expr]:
     a model of sliding only."""
     m, w = d.model, d.work
     exprs = list(w.accelerations) if w.accelerations is not None else list(w.forcing)
+    exprs = [e for e in exprs if isinstance(e, sp.Basic)]
+    _, subs = _args(d)
     found: list[sp.Expr] = []
     for e in exprs:
-        if not isinstance(e, sp.Basic):
-            continue
         for atom in e.atoms(sp.sign):
             u = atom.args[0]
-            if u.has(*m.qd) and u not in found:
-                found.append(u)
+            if not u.has(*m.qd) or u in found:
+                continue
+            jumps = [_plain(x.xreplace({atom: 1}) - x.xreplace({atom: -1}), subs) for x in exprs]
+            if any(j != 0 and not _vanishes_where_zero(j, _plain(u, subs)) for j in jumps):
+                found.append(u)  # not quadratic drag c·sign(ẋ)·ẋ², nor sign(ẋ)·|ẋ| = ẋ
     return found
 
 

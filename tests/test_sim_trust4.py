@@ -304,3 +304,19 @@ def test_steps_held_down_at_a_friction_jump_are_not_called_stiffness():
     (said,) = _why_it_stopped(c, [1.0, 1.0, 0.3, G], SimulationRequest(), run)
     assert "not by stiffness" in said and "sign(x_dot)" in said and "sign(0) = 0" in said
     assert "try Radau" not in said
+
+
+@pytest.mark.parametrize("method", ["DOP853", "Radau"])
+@pytest.mark.parametrize("drag", ["-c*sign(x_dot)*x_dot**2", "c*(sign(x_dot)*abs(x_dot) - x_dot)"])
+def test_a_sign_with_no_jump_is_neither_a_stop_nor_a_warning(client, method, drag):
+    """Quadratic drag −c sign(ẋ) ẋ² is continuous at ẋ = 0 (and the second force is 0): the
+    spring-held block released from rest swings through x = 0 with no stop and no warning.
+    Its first turn, with drag vanishing at rest, is near x = −0.5 at t ≈ π (ω = 1)."""
+    spec = {**COULOMB, "parameters": {**COULOMB["parameters"], "c": 0.01}}
+    spec["forces"] = [{"on": "p", "vector": [drag, 0, 0]}]
+    status, body = post(client, spec, t_end=4, method=method)
+    assert status == 200, body
+    assert body["stats"].get("stop") is None
+    assert not any("sign(x_dot)" in w or "sticks" in w for w in body["warnings"])
+    x = np.array(body["q"]["x"])
+    assert -0.5 <= x.min() < -0.49
