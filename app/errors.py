@@ -28,11 +28,7 @@ _MISMATCH_SUFFIXES = ("_type", "_parsing")
 
 
 def register_error_handlers(app: FastAPI) -> None:
-    """Install the handlers on ``app`` (called once, by app.main), and the refusal of an API
-    query key given twice, an error found before any route runs (app/middleware.py)."""
-    from app.middleware import OneValuePerKey
-
-    app.add_middleware(OneValuePerKey)
+    """Install the handlers on ``app`` (called once, by app.main)."""
     app.add_exception_handler(SpecError, spec_error)
     app.add_exception_handler(ExprError, expr_error)
     app.add_exception_handler(BudgetExceeded, budget_exceeded)

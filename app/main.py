@@ -14,7 +14,7 @@ from app import __version__
 from app.assets import Assets, content_version, package_version
 from app.derivations import pool_lifespan
 from app.errors import register_error_handlers
-from app.middleware import BodyLimit, HeadAsGet, SecurityHeaders
+from app.middleware import BodyLimit, HeadAsGet, OneValuePerKey, SecurityHeaders
 from app.paths import STATIC_DIR, api_docs_dir, mathjax_dir, plotly_dir
 from app.responses import ORJSONResponse
 from app.routes import (
@@ -67,6 +67,7 @@ app.include_router(precision.router)
 app.include_router(pages.router)
 register_error_handlers(app)
 
+app.add_middleware(OneValuePerKey)  # an API query key given twice: a 422 before any route runs
 app.add_middleware(GZipMiddleware, minimum_size=GZIP_MIN_BYTES, compresslevel=GZIP_LEVEL)
 app.add_middleware(BodyLimit, max_bytes=MAX_BODY_BYTES)
 

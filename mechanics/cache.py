@@ -12,6 +12,8 @@ The stores (`STORES`; a name outside this list is a programming error):
 - ``newton``        Newton's method beside Lagrange's for a scene; keyed by the spec.
 - ``check``         a judged answer; keyed by spec + quantity + answer + coordinate + reveal.
 - ``native-source`` the generated C of a scene's right-hand side (text); keyed by spec + branches.
+- ``live-module`` a posted scene's live equations printed as a JavaScript module (text), keyed by
+  its digest, so that every worker process serves the module any of them printed.
   Only the source is shared: mechanics/native compiles it and verifies the library on this
   machine, and never takes a binary from another one.
 
@@ -82,7 +84,7 @@ log = logging.getLogger(__name__)
 
 #: Bump when the output of any store changes (a derivation step, equilibria, the generated C...),
 #: so entries of the old engine are never served. Part of every key and every entry.
-ENGINE_VERSION = "12"
+ENGINE_VERSION = "13"
 
 ENV_VAR = "LAGRANGE_LAB_CACHE"
 REDIS_ENV_VAR = "LAGRANGE_LAB_REDIS_URL"
@@ -114,6 +116,7 @@ STORES: dict[str, Store] = {
         Store("newton", ttl_seconds=30 * DAY),
         Store("check", ttl_seconds=7 * DAY, memory_items=1024),
         Store("native-source", ttl_seconds=30 * DAY, memory_items=64),
+        Store("live-module", ttl_seconds=30 * DAY),
     )
 }
 

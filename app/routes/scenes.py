@@ -85,7 +85,6 @@ class LiveRequest(BaseModel):
 #: module kept in one worker's memory was a 404 in 7 of 12 GETs). An entry is verified on
 #: read: its source must hash to the digest it is asked by.
 LIVE_STORE = "live-module"
-cache.STORES.setdefault(LIVE_STORE, cache.Store(LIVE_STORE, ttl_seconds=30 * cache.DAY))
 _DIGEST = re.compile(r"^[0-9a-f]{16}$")
 
 
