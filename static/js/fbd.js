@@ -347,7 +347,7 @@ function potentialForces(spec, result, parameters, i, known) {
   const out = [];
   for (const b of spec.bodies) {
     const P = result.positions[b.name];
-    if (b.kind !== "particle" || !P) continue;
+    if ((b.kind ?? "particle") !== "particle" || !P) continue; // the schema's default kind
     const m = typeof b.mass === "number" ? b.mass : parameters[b.mass] ?? Number(b.mass);
     if (!Number.isFinite(m)) continue;
     const acc = ["x", "y", "z"].map((c) => (P[c][j + 1] - 2 * P[c][j] + P[c][j - 1]) / (h * h));

@@ -244,7 +244,7 @@ class SceneView {
     const s = this.settings;
     const body = { ...this.target(), parameters: this.params, initial: this.initial, t_end: s.t_end, fps: SERVER_FPS, method, ...extra };
     if (isFixed(method)) body.dt = Number(s.dt);
-    else { body.rtol = Number(s.tol); body.atol = Number(s.tol); }
+    else { body.rtol = Number(s.tol); body.atol = Number(s.atol || s.tol); } // a link's own atol kept
     return body;
   }
 
@@ -365,7 +365,7 @@ class SceneView {
       const s = this.settings;
       // the step the server took (stats.dt) and the samples it sent: a fixed step samples every
       // whole number of steps near 1/fps, so its rate is not always SERVER_FPS
-      const how = isFixed(st.method) ? `dt = ${st.dt ?? s.dt} s` : `rtol = atol = ${s.tol}`;
+      const how = isFixed(st.method) ? `dt = ${st.dt ?? s.dt} s` : (s.atol ? `rtol = ${s.tol}, atol = ${s.atol}` : `rtol = atol = ${s.tol}`);
       const rate = st.sample_interval ? 1 / st.sample_interval : SERVER_FPS;
       const drawn = st.display_factor > 1 ? `; ${fmt(rate, 3)} samples/s, drawn at ${fmt(rate * st.display_factor, 3)} by interpolation` : "";
       // in lecture mode (24 px type beside a narrow canvas) the short form: the full one pushed

@@ -196,11 +196,6 @@ def test_a_shared_atol_stays_in_the_scene_pages_address_until_a_tolerance_is_pic
     assert page.errors == []
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="static/js/scene.js request() sends atol = tol (the lead's file): "
-    "body.atol = Number(s.atol || s.tol) makes this pass; then remove this mark",
-)
 def test_the_runs_a_shared_link_makes_carry_its_atol(server, page):
     p = page.page
     for state in (
