@@ -320,3 +320,35 @@ def test_a_sign_with_no_jump_is_neither_a_stop_nor_a_warning(client, method, dra
     assert not any("sign(x_dot)" in w or "sticks" in w for w in body["warnings"])
     x = np.array(body["q"]["x"])
     assert -0.5 <= x.min() < -0.49
+
+
+def test_the_zero_length_stop_is_found_by_the_c_loop_itself(client):
+    """A spring crossing its anchor is smooth on each side: the C run's samples show it, so the
+    run is not handed to scipy (no note that it was), and it stops as the others do."""
+    status, body = post(client, WIRE, t_end=1, method="dop853_c")
+    assert status == 200, body
+    assert not any("stepped by scipy" in w for w in body["warnings"])
+    assert body["stats"]["stop"]["t"] == pytest.approx(first_zero_of_x(), abs=1e-6)
+
+
+@pytest.mark.parametrize("y0, stops", [(0.0, True), (0.1, False)])
+def test_a_plane_spring_stops_only_when_the_body_goes_through_its_anchor(client, y0, stops):
+    """A particle on a spring (ℓ0 = 1) from the origin, in the plane: launched along the x axis
+    (y ≡ 0) toward the anchor, its motion is the wire's (ℓ = |x|) and it reaches ℓ = 0 when x
+    does; launched 0.1 off the axis it passes beside the anchor and goes on."""
+    spec = {
+        "title": "plane spring",
+        "coordinates": ["x", "y"],
+        "parameters": {"m": 1.0, "k": 10.0, "L0": 1.0},
+        "bodies": [{"name": "b", "mass": "m", "position": ["x", "y", 0]}],
+        "springs": [{"a": "O", "b": "b", "k": "k", "rest_length": "L0"}],
+        "initial": {"x": 0.3, "y": y0, "x_dot": -5.0},
+    }
+    status, body = post(client, spec, t_end=1)
+    assert status == 200, body
+    stop = body["stats"].get("stop")
+    if stops:
+        assert stop is not None and stop["name"].endswith("_at_anchor")
+        assert stop["t"] == pytest.approx(first_zero_of_x(), abs=1e-6)  # the wire's motion
+    else:
+        assert stop is None and min(body["q"]["x"]) < -0.1
