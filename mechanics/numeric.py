@@ -365,7 +365,9 @@ def sticking_stops(d: Derivation) -> list[StopInfo]:
     of server time) and what it shows is no motion. Only for equations solved for q̈, and not
     where the spec declares a sign-change stop of its own (the block on the incline does)."""
     m, w = d.model, d.work
-    if w.accelerations is None or any(st.crossing == "any" for st in m.stops):
+    if w.accelerations is None or any(
+        st.crossing == "any" and st.kind == "declared" for st in m.stops
+    ):
         return []
     out = []
     for u in velocity_jumps(d):
