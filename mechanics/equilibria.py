@@ -202,6 +202,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
                 verdict = _stability(variant, q0, free, values, root.family_dim, power)
         except (_BeyondDoubles, np.linalg.LinAlgError, OverflowError) as exc:
             raise _beyond_doubles(d, parameters or {}, q0, exc) from None
+        except _NotSmooth as exc:
+            if exc.in_position:
+                verdict = _kink_verdict(d, variant, q0, values, power)
+                if _KINK_WARNING not in warnings:
+                    warnings.append(_KINK_WARNING)
+            else:
+                verdict = Verdict("marginal", _NOT_SMOOTH, [], [], [], [], None)
+                if _NOT_SMOOTH_WARNING not in warnings:
+                    warnings.append(_NOT_SMOOTH_WARNING)
         except ValueError as exc:  # sympy cannot differentiate the forces: sign(q̇) at q̇ = 0
             if not _dry_friction(d):  # no friction to blame (g = 1e308 overflows): say so
                 raise _beyond_doubles(d, parameters or {}, q0, exc) from None
@@ -454,13 +463,35 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
 
 
 def _dry_friction(d: Derivation) -> bool:
-    """Does a force depend on the sign (or size) of a velocity, as Coulomb friction does?"""
-    qd = set(d.model.qd)
-    return any(
-        f.args and any(f.args[0].has(v) for v in qd)
-        for Q in d.work.Q
-        for f in (sp.S.Zero + Q).atoms(sp.sign, sp.Abs)
-    )
+    """Does a force jump with the sign of a velocity at rest, as Coulomb friction does? Each
+    |u|, sgn(u) of a velocity is split into its sides (|u| = ±u, sgn u = ±1) and the sides
+    compared at q̇ = 0: −c|v|v and c (sgn(v)|v| − v) ≡ 0 have one value there, and a
+    quadratic drag was 'dry friction acts here'. A comparison sympy cannot settle counts as a
+    jump (the warning is the cautious side)."""
+    m = d.model
+    qds = [sp.Dummy(f"v{j}", real=True) for j in range(len(m.qd))]
+    to_real = {**dict.fromkeys(m.qdd, sp.S.Zero), **dict(zip(m.qd, qds, strict=True))}
+    rest = dict.fromkeys(qds, sp.S.Zero)
+    for Q in d.work.Q:
+        e = (sp.S.Zero + Q).xreplace(to_real)
+        kinks = [
+            k for k in e.atoms(sp.sign, sp.Abs, sp.Heaviside) if k.args and k.args[0].has(*qds)
+        ]
+        if not kinks:
+            continue
+        arguments = sorted({k.args[0] for k in kinks}, key=sp.default_sort_key)
+        if len(arguments) > MAX_KINKS_AT_REST or any(
+            u.has(sp.sign, sp.Abs, sp.Heaviside) for u in arguments
+        ):
+            return True
+        sides = []
+        for signs in itertools.product((1, -1), repeat=len(arguments)):
+            side = dict(zip(arguments, signs, strict=True))
+            piece = e.xreplace({k: _side(k, side[k.args[0]]) for k in kinks})
+            sides.append(piece.replace(sp.DiracDelta, lambda *a: sp.S.Zero).xreplace(rest))
+        if any(sp.simplify(a - sides[0]) != 0 for a in sides[1:]):
+            return True
+    return False
 
 
 def _inside_the_model(m, results, verdicts, values, warnings):
@@ -774,7 +805,7 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
     if family is not None and _in_range(v, family.numeric, values):
         return [family], notes
     system = _System(v, eqs, bound, values, periods)
-    symbolic = _symbolic(m, eqs, bound, values, periods)
+    symbolic = _symbolic(m, eqs, bound, values, periods, _ranges(v, bound, to_zero))
     numeric = _numeric_search(system)
     roots: list[Root] = []
     for root in symbolic or []:
@@ -958,10 +989,18 @@ class _ClosedForm:
     evaluate: Callable[..., Any]
 
 
-def _symbolic(m, eqs, bound, values, periods) -> list[Root] | None:
+def _ranges(v: Variant, bound: list[int], to_zero: dict) -> tuple[sp.Expr, ...]:
+    """Where the conditions hold as derived: a declared-positive coordinate > 0, a spring along
+    a line on its side of the anchor (ℓ = x, not |x|), each to be > 0."""
+    m = v.model
+    positive = [m.q[j] for j in bound if m.coordinate_names[j] in m.spec.positive_coordinates]
+    return tuple(r.xreplace(to_zero) for r in [*positive, *v.ranges])
+
+
+def _symbolic(m, eqs, bound, values, periods, ranges=()) -> list[Root] | None:
     """Closed-form roots with their existence conditions, or None when sympy cannot."""
     psyms = tuple(sorted(values, key=str))
-    solved = _solved(tuple(eqs), tuple((j, m.q[j]) for j in bound), psyms)
+    solved = _solved(tuple(eqs), tuple((j, m.q[j]) for j in bound), psyms, tuple(ranges))
     if solved is None:
         return None
     if not solved and not all(_never_zero(e, values) for e in eqs):
@@ -1027,7 +1066,7 @@ def _numeric_note(eqs: list, bound: list[int], roots: list[Root]) -> str:
 
 
 @functools.lru_cache(maxsize=512)
-def _solved(eqs: tuple, bound: tuple, psyms: tuple) -> list[_ClosedForm] | None:
+def _solved(eqs: tuple, bound: tuple, psyms: tuple, ranges: tuple = ()) -> list[_ClosedForm] | None:
     """sympy's closed-form solutions of the conditions, once per scene (they hold for every
     parameter value; a slider move only evaluates them), or None when sympy cannot solve.
     ``bound``: (index, q) of each coordinate solved for; the index names its symbol, which
@@ -1049,6 +1088,7 @@ def _solved(eqs: tuple, bound: tuple, psyms: tuple) -> list[_ClosedForm] | None:
             return None
         exprs = tuple(sol[subs[q]].xreplace(back) for q in qs)
         conditions = [c for expr in exprs for c in _existence(expr)]
+        conditions += _in_range_when(ranges, dict(zip(qs, exprs, strict=True)), exprs)
         exists = " and ".join(plain for plain, _ in conditions) or "always"
         latex = r" \ \text{and}\  ".join(latex for _, latex in conditions)
         out.append(_ClosedForm(exprs, exists, latex, _evaluator(list(exprs), psyms)))
@@ -1073,6 +1113,28 @@ def _evaluator(exprs: list[sp.Expr], psyms: tuple) -> Callable[..., list]:
 
 def _never_zero(expr, values) -> bool:
     return not expr.free_symbols - set(values) - {t}
+
+
+def _in_range_when(ranges: tuple, solution: dict, exprs: tuple) -> list[tuple[str, str]]:
+    """The closed form's own validity: it solves the conditions of one side of a spring's anchor
+    (or of a positive coordinate) and exists only where it lands on that side, and only where
+    its denominators do not vanish. A bead on a spinning rod, x = L0 k/(k − m Ω²), was
+    'always' while it exists for k > m Ω² only (at k = m Ω² it divides by 0, below it lands on
+    the other side, where the spring pulls the other way)."""
+    out = []
+    for r in ranges:
+        inside = sp.cancel(sp.together(r.xreplace(solution)))
+        if inside.is_positive:
+            continue
+        out.append((f"{to_plain(inside)} > 0", rf"{to_latex(inside)} > 0"))
+    if out:  # a quotient > 0 already says its denominator is not 0
+        return out
+    dens = []
+    for expr in exprs:
+        den = sp.denom(sp.together(expr))
+        if isinstance(den, sp.Add) and den.free_symbols and den not in dens:
+            dens.append(den)
+    return [(f"{to_plain(den)} != 0", rf"{to_latex(den)} \ne 0") for den in dens]
 
 
 def _existence(expr: sp.Expr) -> list[tuple[str, str]]:
@@ -1151,6 +1213,7 @@ class _System:
         self.spread = max([1.0, *self.param_values])
         self.typical = 1.0
         self.timed_out = False
+        self.kinks = _kink_points(m, eqs, bound, values)
 
     def residual_ok(self, X: np.ndarray) -> np.ndarray:
         """Columns of X where every condition vanishes to round-off of its own terms."""
@@ -1174,18 +1237,45 @@ class _System:
         return edge & others
 
 
+def _kink_points(m: Any, eqs: list, bound: list[int], values: dict) -> np.ndarray:
+    """In one coordinate, the points where an argument of |u| or sgn(u) in the conditions
+    vanishes: a force −k sgn(x) balances at x = 0 only, where Newton has no slope to follow
+    (V = k|x| was 'no equilibrium'). Candidates only: the residual decides."""
+    if len(bound) != 1:
+        return np.zeros((len(bound), 0))
+    q = m.q[bound[0]]
+    x = sp.Dummy("x", real=True)
+    numbers = {p: sp.Float(v) for p, v in values.items()}
+    kinks = set().union(*((sp.S.Zero + e).atoms(sp.Abs, sp.sign) for e in eqs))
+    points: list[float] = []
+    for kink in sorted(kinks, key=sp.default_sort_key)[:8]:
+        u = kink.args[0].xreplace({q: x}).xreplace(numbers)
+        if u.free_symbols != {x} or sp.count_ops(u) > 40:
+            continue
+        try:
+            slope = u.diff(x)
+            if not slope.free_symbols and slope != 0:  # linear in x: one root
+                points.append(float(-u.xreplace({x: 0}) / slope))
+        except (TypeError, ValueError):
+            continue
+    return np.array([points]).reshape(1, -1) if points else np.zeros((1, 0))
+
+
 @functools.lru_cache(maxsize=512)
 def _conditions_numeric(eqs: tuple, qs: tuple, all_qs: tuple, ranges: tuple, psyms: tuple):
     """The conditions, their Jacobian, their terms' sizes and the coordinates' ranges as numpy
     functions of the bound coordinates and the parameters, once per scene: a slider move only
     calls them with new numbers."""
-    xs = [sp.Dummy(f"x{j}") for j in range(len(qs))]
+    # real: d|x|/dx is then sgn x (of a complex x, Derivative(re(x), x), which numpy cannot
+    # print: V = k|x| was a 500), and d sgn(x)/dx = 2δ(x), 0 off the kink where Newton steps
+    xs = [sp.Dummy(f"x{j}", real=True) for j in range(len(qs))]
     to_x = dict(zip(qs, xs, strict=True))
     to_x.update({q: 0 for q in all_qs if q not in to_x})
-    f = [e.xreplace(to_x) for e in eqs]
+    f = [e.xreplace(to_x).replace(sp.DiracDelta, lambda *a: sp.S.Zero) for e in eqs]
+    jac = [fi.diff(x).replace(sp.DiracDelta, lambda *a: sp.S.Zero) for fi in f for x in xs]
     return (
         _vectorized(f, xs, psyms),
-        _vectorized([fi.diff(x) for fi in f for x in xs], xs, psyms),
+        _vectorized(jac, xs, psyms),
         _vectorized([sp.Add(*(sp.Abs(a) for a in sp.Add.make_args(fi))) for fi in f], xs, psyms),
         _vectorized([r.xreplace(to_x) for r in ranges], xs, psyms),
     )
@@ -1250,7 +1340,7 @@ def _numeric_search(system: _System) -> list[list[float]]:
         if not active.any():
             break
     alive = np.all(np.isfinite(X), axis=0)
-    X = X[:, alive]
+    X = np.hstack([X[:, alive], system.kinks])
     balanced = system.residual_ok(X)
     edge = balanced & ~system.in_range(X) & system.on_edge(X)
     for x in X[:, edge].T[:1]:
@@ -1420,6 +1510,8 @@ def _never_positive(m: Any, power: sp.Expr) -> bool:
     try:
         if (-p).is_nonnegative or (-sp.factor(p)).is_nonnegative:
             return True
+        if _never_positive_by_sides(p):
+            return True
         v = [real[qd] for qd in m.qd]
         if not sp.Poly(p, *v).is_homogeneous or sp.Poly(p, *v).total_degree() != 2:
             return False
@@ -1427,6 +1519,25 @@ def _never_positive(m: Any, power: sp.Expr) -> bool:
         return bool(D.is_negative_semidefinite)
     except (TypeError, ValueError, RecursionError, sp.PolynomialError):
         return False
+
+
+def _never_positive_by_sides(p: sp.Expr) -> bool:
+    """P ≤ 0 side by side of each velocity in |v| or sgn(v): v = ±w with w > 0, or v = 0.
+    −c sgn(θ̇) θ̇³ is −c|θ̇|³ ≤ 0, which sympy does not see as written (a quadratic drag
+    written with sign was 'power has no sign')."""
+    kinks = p.atoms(sp.Abs, sp.sign)
+    if not kinks:
+        return False
+    variables = {k.args[0] for k in kinks}
+    if len(variables) > 3 or not all(isinstance(u, sp.Symbol) for u in variables):
+        return False
+    variables = sorted(variables, key=sp.default_sort_key)
+    ws = [sp.Dummy(positive=True) for _ in variables]
+    for sides in itertools.product(*((w, -w, sp.S.Zero) for w in ws)):
+        case = p.xreplace(dict(zip(variables, sides, strict=True)))
+        if not ((-case).is_nonnegative or (-sp.factor(case)).is_nonnegative):
+            return False
+    return True
 
 
 def _quadratic_wins(m: Any, power: sp.Expr, q0: list[float]) -> bool:
@@ -1482,6 +1593,164 @@ def _linearization(mass: tuple, forcing: tuple, qs: tuple, qds: tuple, qdds: tup
     return sp.lambdify([*xs, *psyms], exprs, modules="numpy", dummify=True)
 
 
+class _NotSmooth(ValueError):
+    """The forces have a kink or a jump at this equilibrium: no linearization. ``in_position``:
+    every kink is one of q alone (V = k|x|), none of a velocity (dry friction's sgn(q̇))."""
+
+    def __init__(self, in_position: bool) -> None:
+        super().__init__("not differentiable at rest")
+        self.in_position = in_position
+
+
+#: Kinks at an equilibrium whose sides are compared (2 per kink): beyond, no verdict.
+MAX_KINKS_AT_REST = 4
+
+
+def _piecewise_linearization(v: Variant, q0: list[float], values: dict):
+    """M, K, C at rest where the forces hold |u|, sgn(u) or H(u): each kink's argument u that
+    vanishes here is split into its sides (|u| = ±u, sgn u = ±1), and the smooth pieces must
+    agree, in value and in first derivatives. Then the forces are C¹ here and the pieces'
+    common M, K, C is the linearization: a quadratic drag −c|θ̇|θ̇ has C = 0 at rest, which
+    'not differentiable, undecided' missed. Pieces that disagree (sgn θ̇ jumps, k|x| bends)
+    raise _NotSmooth. Real symbols throughout: d|x|/dx of a complex x is not sgn x."""
+    m = v.model
+    n = len(m.q)
+    qs = [sp.Dummy(f"q{j}", real=True) for j in range(n)]
+    qds = [sp.Dummy(f"v{j}", real=True) for j in range(n)]
+    to_real = {**dict.fromkeys(m.qdd, sp.S.Zero), **dict(zip(m.qd, qds, strict=True))}
+    to_real.update(dict(zip(m.q, qs, strict=True)))
+    numbers = {p: sp.Float(x) for p, x in values.items()}
+    exprs = [
+        sp.S.Zero + e.xreplace(to_real).xreplace(numbers) for e in (*v.mass_matrix, *v.forcing)
+    ]
+    at = {**dict(zip(qs, map(sp.Float, q0), strict=True)), **dict.fromkeys(qds, sp.S.Zero)}
+    kinks = set().union(*(e.atoms(sp.Abs, sp.sign, sp.Heaviside) for e in exprs))
+    fixed, split = {}, []
+    for kink in sorted(kinks, key=sp.default_sort_key):
+        u = kink.args[0]
+        if u.has(sp.Abs, sp.sign, sp.Heaviside):
+            raise _NotSmooth(not u.has(*qds))
+        u0 = complex(u.xreplace(at).evalf())
+        if abs(u0.imag) > 1e-12:
+            raise _NotSmooth(not u.has(*qds))
+        scale = max(1.0, *(abs(float(a.xreplace(at).evalf())) for a in sp.Add.make_args(u)))
+        if abs(u0.real) > 1e-12 * scale:
+            fixed[kink] = _side(kink, 1 if u0.real > 0 else -1)
+        else:
+            split.append(kink)
+    if len({k.args[0] for k in split}) > MAX_KINKS_AT_REST:
+        raise _NotSmooth(not any(k.args[0].has(*qds) for k in split))
+    arguments = sorted({k.args[0] for k in split}, key=sp.default_sort_key)
+    pieces = []
+    for signs in itertools.product((1, -1), repeat=len(arguments)):
+        side = dict(zip(arguments, signs, strict=True))
+        rule = {**fixed, **{k: _side(k, side[k.args[0]]) for k in split}}
+        smooth = [e.xreplace(rule).replace(sp.DiracDelta, lambda *a: sp.S.Zero) for e in exprs]
+        if any(e.has(t) for e in smooth[n * n :]):
+            return _TIMED
+        mass, forcing = smooth[: n * n], smooth[n * n :]
+        pieces.append(
+            [
+                [float(e.xreplace(at)) for e in mass],
+                [float(f.xreplace(at)) for f in forcing],
+                [-float(f.diff(q).xreplace(at)) for f in forcing for q in qs],
+                [-float(f.diff(qd).xreplace(at)) for f in forcing for qd in qds],
+            ]
+        )
+    first = [np.array(x) for x in pieces[0]]
+    for piece in pieces[1:]:
+        for a, b in zip(first, piece, strict=True):
+            size = max(1.0, float(np.max(np.abs(a), initial=0.0)))
+            if not np.allclose(a, b, rtol=1e-9, atol=1e-9 * size):
+                raise _NotSmooth(not any(u.has(*qds) for u in arguments))
+    M, _, K, C = first
+    return M.reshape(n, n), K.reshape(n, n), C.reshape(n, n)
+
+
+def _side(kink: sp.Expr, sign: int) -> sp.Expr:
+    """|u|, sgn u or H(u) on the side of u's sign."""
+    u = kink.args[0]
+    if isinstance(kink, sp.Abs):
+        return sign * u
+    if isinstance(kink, sp.sign):
+        return sp.Integer(sign)
+    return sp.Integer(1 if sign > 0 else 0)
+
+
+def _kink_verdict(d: Derivation, v: Variant, q0: list[float], values: dict, power: Power):
+    """An equilibrium at a kink of the forces of q alone (V = k|x| at 0): no linearization, but
+    in one coordinate the force itself says what V does on each side. Pushed back from both
+    sides, V has a minimum there (a position force in one coordinate has a potential), and with
+    forces of q̇ that do no positive work it is stable (Lagrange–Dirichlet); pushed away on a
+    side, a nudge that way runs off. In more coordinates no sampling proves a minimum."""
+    m = v.model
+    if len(m.q) != 1:
+        return Verdict("marginal", _KINK, [], [], [], [], None)
+    rest = {**dict.fromkeys(m.qdd, sp.S.Zero), **dict.fromkeys(m.qd, sp.S.Zero)}
+    numbers = {p: sp.Float(x) for p, x in values.items()}
+    f = (sp.S.Zero + v.forcing[0]).xreplace(rest).xreplace(numbers)
+    pushes = []
+    for side in (1, -1):
+        for eps in (1e-4, 1e-6):
+            step = side * eps * max(1.0, abs(q0[0]))
+            try:
+                value = float(f.xreplace({m.q[0]: sp.Float(q0[0] + step)}).evalf())
+            except (TypeError, ValueError):
+                return Verdict("marginal", _KINK, [], [], [], [], None)
+            pushes.append(value * side)
+    name = m.coordinate_names[0]
+    if all(p < 0 for p in pushes):
+        if power.kind == "no sign":
+            return Verdict(
+                "marginal",
+                f"{_KINK_NO_LINEAR}; the force pushes back toward it from both sides (the "
+                f"potential has a minimum with a kink here), but the velocity-dependent forces' "
+                f"power {power.text} has no sign: they can feed energy in, so the minimum need "
+                "not hold the motion",
+                [],
+                [],
+                [],
+                [],
+                None,
+            )
+        return Verdict(
+            "stable",
+            f"{_KINK_NO_LINEAR}, but the force pushes back toward it from both sides of "
+            f"{name}: the potential has a minimum at the kink, and the "
+            "velocity-dependent forces do no positive work, so the energy cannot carry a small "
+            "motion away: stable by the potential (Lagrange–Dirichlet)",
+            [],
+            [],
+            [],
+            [],
+            None,
+        )
+    if any(p > 0 for p in pushes):
+        return Verdict(
+            "unstable",
+            f"{_KINK_NO_LINEAR}, but on one side of it at least the force pushes {name} further "
+            "away (the potential falls from the kink): a small displacement that way runs off",
+            [],
+            [],
+            [],
+            [],
+            None,
+        )
+    return Verdict("marginal", _KINK, [], [], [], [], None)
+
+
+_KINK_NO_LINEAR = (
+    "the forces are not differentiable at this point (a kink of the potential, as $k|x|$ at "
+    "0), so there is no linearization"
+)
+_KINK = f"{_KINK_NO_LINEAR}: the linear test cannot decide"
+_KINK_WARNING = (
+    "Some equilibria lie at a kink of the potential (a force that jumps there, as $-k\\,"
+    "\\operatorname{sgn} x$ of $V = k|x|$): they have no linearization, and no frequencies "
+    "are given for them."
+)
+
+
 @functools.lru_cache(maxsize=4096)
 def _derivative(expr: sp.Expr, var: sp.Expr) -> sp.Expr:
     """∂f/∂q of the forcing, once per scene: every equilibrium and every parameter value needs
@@ -1510,9 +1779,12 @@ def _stability(
     m = v.model
     n = len(m.q)
     psyms = tuple(sorted(values, key=str))
-    at_rest = _linearization(
-        tuple(v.mass_matrix), tuple(v.forcing), tuple(m.q), tuple(m.qd), tuple(m.qdd), psyms
-    )
+    try:
+        at_rest = _linearization(
+            tuple(v.mass_matrix), tuple(v.forcing), tuple(m.q), tuple(m.qd), tuple(m.qdd), psyms
+        )
+    except ValueError:  # sympy cannot differentiate |q̇| of q̇(t): the pieces below can
+        at_rest = None
     if at_rest is _TIMED:
         return Verdict("marginal", _TIME_VARYING, [], [], [], [], None)
     if at_rest is not None:
@@ -1520,16 +1792,11 @@ def _stability(
         with np.errstate(all="ignore"):
             M_, K_, C_ = (np.array(x, dtype=float) for x in at_rest(*q0, *numbers))
         full_M = M_.reshape(n, n)
-    else:  # not smooth at rest (sign(q̇)): sympy says why (ValueError) where it cannot go on
-        point = {**values, **{q: sp.Float(v) for q, v in zip(m.q, q0, strict=True)}}
-        rest = {**dict.fromkeys(m.qdd, 0), **dict.fromkeys(m.qd, 0)}
-
-        def num(e):
-            return float(sp.S.Zero + e.xreplace(rest).xreplace(point))
-
-        full_M = np.array([[num(v.mass_matrix[j, k]) for k in range(n)] for j in range(n)])
-        K_ = np.array([[-num(_derivative(fj, q)) for q in m.q] for fj in v.forcing])
-        C_ = np.array([[-num(_derivative(fj, qd)) for qd in m.qd] for fj in v.forcing])
+    else:  # |q̇| q̇ is C¹ at rest, sign(q̇) is not: the smooth pieces decide (_NotSmooth)
+        pieces = _piecewise_linearization(v, q0, values)
+        if pieces is _TIMED:
+            return Verdict("marginal", _TIME_VARYING, [], [], [], [], None)
+        full_M, K_, C_ = pieces
     # A row of M that vanishes here (φ at a sphere's pole), relative to the others: an
     # absolute 1e-12 took m = 1e-13 for no inertia at all, and every equilibrium for stable.
     inertia = float(np.max(np.abs(np.diag(full_M)), initial=0.0))
@@ -2016,8 +2283,11 @@ def _semisimple(A: np.ndarray, on_axis: np.ndarray, scale: float) -> bool:
 
 def _modes(M, C, K, lam, vecs, idx, n):
     """ω from the imaginary parts of the eigenvalues, one per conjugate pair, ascending; modes
-    as displacement shapes (max |·| = 1). Without velocity terms they are real (K v = ω² M v);
-    with them a mode may whirl: its amplitudes and each coordinate's phase lag are given."""
+    as displacement shapes (max |·| = 1). Without velocity terms and with K symmetric they are
+    real (K v = ω² M v); with them a mode may whirl: its amplitudes and each coordinate's phase
+    lag are given. A non-symmetric K (a follower load) is taken whole, from the eigenproblem the
+    reason quotes: its symmetric part gave a Ziegler column ω = 0.400, 1.530 beside
+    λ = ±0.468i, ±1.510i."""
     size = len(idx)
     scale = max(1.0, float(np.max(np.abs(lam)))) if len(lam) else 1.0
     freqs, modes, phases = [], [], []
@@ -2028,7 +2298,8 @@ def _modes(M, C, K, lam, vecs, idx, n):
             mode[j] = float(x)
         return mode
 
-    if not np.any(C):
+    k_norm = max(float(np.max(np.abs(K), initial=0.0)), 1e-300)
+    if not np.any(C) and np.max(np.abs(K - K.T), initial=0.0) <= 1e-9 * k_norm:
         import scipy.linalg
 
         w2, vecs_r = scipy.linalg.eigh((K + K.T) / 2, M)
