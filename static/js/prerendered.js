@@ -55,32 +55,31 @@ export async function usePrerendered(url, live) {
 export function applyPrerendered(elements) {
   if (!table) return elements;
   const left = [];
+  const found = []; // [root, text node, its font size]: all read before anything is written, as
+  // each change of the page would make the next font size cost a new style pass of it all
   for (const root of elements) {
     if (!root.closest?.("#steps")) { left.push(root); continue; }
     const walker = document.createTreeWalker(root, NodeFilter.SHOW_TEXT, {
       acceptNode: (n) => (n.parentElement?.closest(SKIP) ? NodeFilter.FILTER_REJECT : NodeFilter.FILTER_ACCEPT),
     });
-    const nodes = [];
     for (let n = walker.nextNode(); n; n = walker.nextNode()) {
-      if (n.nodeValue.includes("\\[") || n.nodeValue.includes("\\(")) nodes.push(n);
+      if (n.nodeValue.includes("\\[") || n.nodeValue.includes("\\(")) found.push([root, n]);
     }
-    let missed = false;
-    for (const node of nodes) missed = !replace(node) || missed;
-    if (missed) left.push(root);
   }
-  return left;
+  for (const item of found) item.push(+parseFloat(getComputedStyle(item[1].parentElement).fontSize).toFixed(2));
+  const missed = new Set();
+  for (const [root, node, px] of found) if (!replace(node, px)) missed.add(root);
+  return [...left, ...elements.filter((root) => missed.has(root))];
 }
 
 /** One text node's math, all of it from the table, or nothing (false). */
-function replace(node) {
+function replace(node, px) {
   const text = node.nodeValue;
   const parts = [];
   let at = 0;
-  let px = null;
   for (const m of text.matchAll(DELIMITED)) {
     const display = m[1] !== undefined;
     const tex = display ? m[1] : m[2];
-    px ??= +parseFloat(getComputedStyle(node.parentElement).fontSize).toFixed(2);
     const html = table.get(`${display ? "D" : "I"}${px}|${tex}`);
     if (typeof html !== "string") return false;
     parts.push(text.slice(at, m.index), container(html, tex, display));
