@@ -129,8 +129,12 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     conditions = _once(d, "at rest", zeros, lambda: _at_rest(base)) if zeros else general
     conditions = [_drop_idle_drive(d, c, values) for c in conditions]
     if any(explicit_time(c, m) for c in conditions):
+        # a hoop spun about a horizontal diameter has no amplitude to set to 0
         warnings.append(
-            "The forces at rest depend on time (a drive): there is no fixed "
+            "The forces at rest depend on time (a frame turning at a prescribed rate carries "
+            "gravity round in it): there is no fixed equilibrium."
+            if _frame_turns(m)
+            else "The forces at rest depend on time (a drive): there is no fixed "
             "equilibrium. Set the drive amplitude to 0 to find the undriven ones."
         )
         return {"steps": [s.to_json() for s in steps], "equilibria": [], "warnings": warnings}
@@ -169,8 +173,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     found.sort(key=lambda vr: [abs(vr[1].numeric.get(j, 0.0)) for j in range(len(m.q))])
     if len(found) > MAX_EQUILIBRIA:
         warnings.append(
-            f"More than {MAX_EQUILIBRIA} equilibria (a continuum?): only the first "
-            f"{MAX_EQUILIBRIA} are listed."
+            f"More than {MAX_EQUILIBRIA} equilibria"
+            + (" (a continuum?)" if _crowded([r.numeric for _, r in found], periods) else "")
+            + f": only the first {MAX_EQUILIBRIA} are listed."
         )
         found = found[:MAX_EQUILIBRIA]
     free = sorted({j for j, c in enumerate(conditions) if c == 0} | set(idle))
@@ -262,6 +267,24 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     elif not dry and not any(w.startswith(_EDGE) for w in warnings):
         warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
+
+
+def _crowded(points: list[dict[int, float]], periods: dict[int, float]) -> bool:
+    """Do some of the equilibria found lie next to each other (1e-3 apart), as points of a
+    continuum the search samples do? A 6-link chain's 2⁶ = 64 isolated ones do not: a
+    'continuum?' there was a false hint."""
+    points = points[:100]
+    for i, a in enumerate(points):
+        for b in points[:i]:
+            gap = 0.0
+            for j in set(a) | set(b):
+                diff = a.get(j, 0.0) - b.get(j, 0.0)
+                if j in periods:
+                    diff = math.remainder(diff, periods[j])
+                gap = max(gap, abs(diff) / max(1.0, abs(a.get(j, 0.0))))
+            if gap < 1e-3:
+                return True
+    return False
 
 
 #: The order in which one configuration's verdicts are kept: the most cautious first.
@@ -1998,16 +2021,31 @@ def _radial(m, full_M, at_rest, q0, numbers, idx, lost) -> list[int]:
     return out
 
 
-def _turning(m: Any) -> bool:
+def _turning(m: Any) -> str:
     """Does a position move with time by prescription (a hoop spun at Ω)? Then K is the
     Hessian of the effective potential, V less the centrifugal term, not of V: the bead's
-    V = −mgR cos θ has its minimum at θ = 0, where the spinning hoop's bead is unstable."""
-    return any(
+    V = −mgR cos θ has its minimum at θ = 0, where the spinning hoop's bead is unstable.
+    "frame" when a frame turns at a prescribed angle (the centrifugal term is its share),
+    "moving" when only a point is moved (a support at x = v t: no frame turns), "" otherwise."""
+    if not any(
         explicit_time(component, m) for r in m.positions.values() for component in r.to_matrix(m.N)
-    )
+    ):
+        return ""
+    return "frame" if _frame_turns(m) else "moving"
 
 
-def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = Power()):
+def _frame_turns(m: Any) -> bool:
+    """Is a frame's angle prescribed in time (Ω t)?"""
+    for i, f in enumerate(m.spec.frames):
+        try:
+            if explicit_time(parse(f.angle, m.names, field=f"frames[{i}].angle"), m):
+                return True
+        except SpecError:
+            continue
+    return False
+
+
+def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power()):
     n = len(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam, vecs = np.linalg.eig(A)
@@ -2144,10 +2182,7 @@ def _classify(M, C, K, n_free, names, *, turning: bool = False, power: Power = P
                 f"{_potential(turning)} has a minimum across them"
             )
         if gyroscopic or damped:  # only then is there a velocity-linear term to speak of
-            reason = (
-                f"$\\mathbf K$ is positive definite, so the {_potential(turning)} has a minimum; "
-                "velocity-linear terms cannot undo that (Thomson–Tait)"
-            )
+            reason += "; velocity-linear terms cannot undo that (Thomson–Tait)"
         if power.kind == "no work":
             reason += (
                 "; the velocity-dependent forces do no work (their power "
@@ -2224,14 +2259,15 @@ def _circulatory(grow: complex, tol: float) -> str:
     return f"{_CIRCULATORY}: divergence, a real positive eigenvalue, a drift that grows"
 
 
-def _gyroscopic(turning: bool, power: Power) -> str:
+def _gyroscopic(turning: str, power: Power) -> str:
     """The velocity-linear terms by their source: Coriolis where a frame turns at a prescribed
     rate (T has terms linear in q̇), forces that do no work (a magnetic one) otherwise."""
     forces = power.kind == "no work"
+    source = "Coriolis" if turning == "frame" else "the prescribed motion's"
     if turning and forces:
-        return "gyroscopic (Coriolis, and forces that do no work)"
+        return f"gyroscopic ({source}, and forces that do no work)"
     if turning:
-        return "gyroscopic (Coriolis)"
+        return f"gyroscopic ({source})"
     if forces:
         return "gyroscopic (forces that do no work, like a magnetic one)"
     return "gyroscopic"
@@ -2259,9 +2295,14 @@ def _eigen_sorted(lam: np.ndarray) -> list[complex]:
     return [complex(lam[i]) for i in _eigen_order(lam)]
 
 
-def _potential(turning: bool) -> str:
-    if turning:
+def _potential(turning: str) -> str:
+    if turning == "frame":
         return "effective potential ($V$ with the centrifugal term of the turning frame)"
+    if turning:  # a support moved by prescription: no frame turns, no centrifugal term
+        return (
+            "effective potential ($V$ less $T_0$, the kinetic energy of the prescribed motion "
+            "at $\\dot q = 0$)"
+        )
     return "potential"
 
 

@@ -207,3 +207,128 @@ def test_kinked_forces_are_never_a_500(spec):
     if spec["title"].startswith("bead"):  # the spring rests at its length on either side
         xs = sorted(e["q"]["x"] for e in r.json()["equilibria"])
         assert xs == pytest.approx([-1.0, 1.0], abs=1e-9)
+
+
+# --- 5. sentences that said what is not there -------------------------------------------------
+
+
+def test_a_support_moved_at_constant_speed_has_no_turning_frame():
+    """x_s = v t: no inertial force (ẍ_s = 0), K = m g l at the bottom, ω = √(g/l); no frame
+    turns, so no centrifugal term is named."""
+    spec = {
+        "title": "pendulum on a moving support",
+        "coordinates": ["theta"],
+        "parameters": {"m": 1.0, "l": 1.0, "g": 9.81, "v": 2.0},
+        "points": [{"name": "S", "position": ["v*t", 0, 0]}],
+        "bodies": [
+            {
+                "name": "bob",
+                "mass": "m",
+                "position": {
+                    "frame": "N",
+                    "components": ["l*sin(theta)", "-l*cos(theta)", 0],
+                    "from": "S",
+                },
+            }
+        ],
+        "gravity": {"acceleration": "g"},
+    }
+    out = equilibria(derive_model(spec))
+    bottom = next(e for e in out["equilibria"] if abs(e["q"]["theta"]) < 1e-9)
+    assert bottom["kind"] == "stable"
+    assert bottom["frequencies"] == pytest.approx([math.sqrt(9.81)], rel=1e-9)
+    assert "centrifugal" not in bottom["reason"] and "turning" not in bottom["reason"]
+
+
+def hoop(axis: str) -> dict:
+    """A bead on a hoop of radius R in the frame H spun at Ω about N's axis ``axis``."""
+    return {
+        "title": "spun hoop",
+        "coordinates": ["theta"],
+        "parameters": {"m": 1.0, "R": 1.0, "g": 9.81, "Omega": 2.0},
+        "frames": [{"name": "H", "parent": "N", "axis": axis, "angle": "Omega*t"}],
+        "bodies": [
+            {
+                "name": "bead",
+                "mass": "m",
+                "position": {
+                    "frame": "H",
+                    "components": ["R*sin(theta)", "-R*cos(theta)", 0],
+                },
+            }
+        ],
+        "gravity": {"acceleration": "g"},
+    }
+
+
+def test_a_hoop_spun_about_a_horizontal_diameter_has_no_amplitude_to_set():
+    """About the horizontal x axis, gravity turns round in H: the forces at rest depend on t
+    and nothing balances for good; there is no drive amplitude to set to 0. About the vertical
+    (the control) the bottom is an equilibrium of the effective potential."""
+    out = equilibria(derive_model(hoop("x")))
+    assert out["equilibria"] == []
+    assert any("no fixed equilibrium" in w for w in out["warnings"])
+    assert not any("amplitude" in w for w in out["warnings"])
+    upright = equilibria(derive_model(hoop("y")))
+    assert any(abs(e["q"]["theta"]) < 1e-9 for e in upright["equilibria"])
+    assert any("centrifugal" in e["reason"] for e in upright["equilibria"])
+
+
+def test_many_isolated_equilibria_are_not_called_a_continuum():
+    """Five independent pendula: 2⁵ = 32 isolated equilibria (each θᵢ ∈ {0, π}), more than the
+    listing holds; the two masses on a spring in the plane (relative vector (x, y), |(x, y)| = L
+    a circle of them) do crowd together, and there the hint stands."""
+    names = [f"a{i}" for i in range(5)]
+    pendula = {
+        "title": "five pendula",
+        "coordinates": names,
+        "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
+        "bodies": [
+            {"name": f"b{i}", "mass": "m", "position": [f"{i}+l*sin({a})", f"-l*cos({a})", 0]}
+            for i, a in enumerate(names)
+        ],
+        "gravity": {"acceleration": "g"},
+    }
+    out = equilibria(derive_model(pendula))
+    assert len(out["equilibria"]) == 24
+    assert all(
+        min(abs(math.remainder(x, math.pi)) for x in [q]) < 1e-9
+        for e in out["equilibria"]
+        for q in e["q"].values()
+    )
+    (note,) = [w for w in out["warnings"] if w.startswith("More than")]
+    assert "continuum" not in note
+    circle = equilibria(derive_model(two_masses(["X", "Y", "x", "y"])))
+    assert any("continuum" in w for w in circle["warnings"])
+
+
+def two_masses(coordinates: list[str]) -> dict:
+    """Masses m at centre ± half the relative vector, joined by a spring (rest L) and damper."""
+    X, Y, x, y = (
+        (coordinates[0], "0", coordinates[1], "0") if len(coordinates) == 2 else coordinates
+    )
+    return {
+        "title": "two masses",
+        "coordinates": coordinates,
+        "parameters": {"m": 1.0, "k": 10.0, "c": 0.5, "L": 1.0},
+        "bodies": [
+            {"name": "a", "mass": "m", "position": [f"{X} - {x}/2", f"{Y} - ({y})/2", 0]},
+            {"name": "b", "mass": "m", "position": [f"{X} + {x}/2", f"{Y} + ({y})/2", 0]},
+        ],
+        "springs": [{"a": "a", "b": "b", "k": "k", "rest_length": "L"}],
+        "dampers": [{"a": "a", "b": "b", "c": "c"}],
+    }
+
+
+def test_a_free_centre_of_mass_is_not_hidden_behind_positive_definite():
+    """Centre X and separation x on a line: K = diag(0, k/…) is singular along the free X, so
+    'K is positive definite' (what the damped case said) is false; it is definite off X. The
+    separation obeys (m/2) ẍ + c ẋ + k (x − L) = 0: it rests at x = L, and its damped pair has
+    Im λ = √(2k/m − (c/m)²)."""
+    out = equilibria(derive_model(two_masses(["X", "x"])))
+    e = next(e for e in out["equilibria"] if e["q"]["x"] > 0)
+    assert e["q"]["x"] == pytest.approx(1.0, abs=1e-9)
+    assert e["kind"] == "stable"
+    assert "positive definite off" in e["reason"]
+    k, c, m = 10.0, 0.5, 1.0
+    assert e["frequencies"] == pytest.approx([math.sqrt(2 * k / m - (c / m) ** 2)], rel=1e-9)
