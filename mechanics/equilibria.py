@@ -1109,8 +1109,8 @@ def _solved(eqs: tuple, bound: tuple, psyms: tuple, ranges: tuple = ()) -> list[
     for sol in sols:
         if len(sol) < len(qs) or any(v.free_symbols & set(subs.values()) for v in sol.values()):
             return None
-        exprs = tuple(sol[subs[q]].xreplace(back) for q in qs)
-        conditions = [c for expr in exprs for c in _existence(expr)]
+        exprs, conditions = _unpiece(tuple(sol[subs[q]].xreplace(back) for q in qs))
+        conditions += [c for expr in exprs for c in _existence(expr)]
         conditions += _in_range_when(ranges, dict(zip(qs, exprs, strict=True)), exprs)
         exists = " and ".join(plain for plain, _ in conditions) or "always"
         latex = r" \ \text{and}\  ".join(latex for _, latex in conditions)
@@ -1136,6 +1136,25 @@ def _evaluator(exprs: list[sp.Expr], psyms: tuple) -> Callable[..., list]:
 
 def _never_zero(expr, values) -> bool:
     return not expr.free_symbols - set(values) - {t}
+
+
+def _unpiece(exprs: tuple) -> tuple[tuple, list[tuple[str, str]]]:
+    """sympy's Piecewise((−L0, L0 > 0), (nan, True)) is −L0 where L0 > 0 and nothing otherwise:
+    the value and its condition, stated (it was shown whole, beside 'always')."""
+    out, conditions = [], []
+    for expr in exprs:
+        if (
+            isinstance(expr, sp.Piecewise)
+            and len(expr.args) == 2
+            and expr.args[1].expr is sp.nan
+            and expr.args[1].cond == sp.true
+        ):
+            value, cond = expr.args[0]
+            out.append(value)
+            conditions.append((to_plain(cond), to_latex(cond)))
+        else:
+            out.append(expr)
+    return tuple(out), conditions
 
 
 def _in_range_when(ranges: tuple, solution: dict, exprs: tuple) -> list[tuple[str, str]]:
