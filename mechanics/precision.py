@@ -45,7 +45,6 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-import sympy as sp
 
 from mechanics.divergence import compare_runs, worth_classifying
 from mechanics.integrators import METHODS, Trajectory, integrate
@@ -56,10 +55,9 @@ from mechanics.simulate import (
     SimulationRequest,
     _OtherBranch,
     check_request,
-    constant_mass_matrix,
+    why_not_symplectic,
 )
 from mechanics.spec import SpecError
-from mechanics.steps.conserved import explicit_time, vanishes
 
 MAX_METHODS = 6
 MAX_SETTINGS = 8
@@ -440,56 +438,6 @@ def horizon_warning(verdict: Any, t_end: float) -> str:
         "predictability horizon, not the methods: a point with no digit right says nothing "
         f"about its method. For a work–precision diagram take t_end below about {parted:.3g} s."
     )
-
-
-def why_not_symplectic(c: CompiledScene, params: list[float]) -> str | None:
-    """Why symplectic Euler and the implicit midpoint step do not keep a modified energy on this
-    motion, in the words the page shows; None where they do. One rule for every claim of a
-    bounded energy error (the methods' rows, the long run).
-
-    They do on the flow of a Hamiltonian H(q, p) free of t, stepped in variables that are a
-    linear change of (q, p): L free of t, no power of the non-conservative forces (judged at
-    these parameters: a damper with c = 0 does no work), M constant (p = M q̇), and q̈ free of
-    q̇ (their explicit update of q̇ is the symplectic one only for forces of q alone). A damped,
-    driven or rubbing motion conserves no energy at all (the error measured is the energy
-    balance's), so there is nothing for a modified energy to stay close to."""
-    m, work = c.derivation.model, c.derivation.work
-    values = {
-        m.params[name]: sp.Rational(repr(float(v)))
-        for name, v in zip(c.parameters, params, strict=True)
-    }
-    Q = [sp.sympify(q).xreplace(values) for q in work.Q]
-    power = sp.expand(sum((q * qd for q, qd in zip(Q, m.qd, strict=True)), sp.S.Zero))
-    if not vanishes(power, m):
-        return (
-            "non-conservative forces do work on this motion (a damper, friction or a driving "
-            "force: Σ Q_j q̇_j ≠ 0), so its energy is not conserved and there is no conserved "
-            "energy for symplectic Euler to stay close to; the error shown is that of the energy "
-            "balance ΔT + ΔV − W_NC, which is not bound to stay bounded"
-        )
-    if explicit_time(work.L.xreplace(values), m):
-        return (
-            "L depends explicitly on t (a driven or moving support), so no energy is conserved "
-            "and there is no fixed Hamiltonian whose modified version symplectic Euler could keep"
-        )
-    if not constant_mass_matrix(c):
-        return (
-            "the mass matrix changes with the coordinates, so symplectic Euler, which steps q and "
-            "q̇ rather than the momenta p = M(q) q̇, is not symplectic here: its energy error is "
-            "not bound to stay bounded"
-        )
-    forcing = work.forcing if work.forcing is not None else work.accelerations
-    if forcing is None:
-        return "the equations were too large to check whether the forces depend on q̇ or on t"
-    for f in forcing:
-        f = sp.sympify(f).xreplace(values)
-        if f.has(*m.qd) or explicit_time(f, m):
-            return (
-                "the forces depend on the velocities (a gyroscopic force, like a magnetic one), "
-                "and symplectic Euler's explicit update of q̇ is not the symplectic map of such "
-                "a flow"
-            )
-    return None
 
 
 def period_window(t_end: float) -> float:

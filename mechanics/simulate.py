@@ -34,6 +34,7 @@ from mechanics.numeric import (
     velocity_jump_functions,
 )
 from mechanics.spec import SpecError
+from mechanics.steps.conserved import explicit_time, vanishes
 from mechanics.stops import (
     StopEvent,
     first_stop,
@@ -539,13 +540,13 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     stats["momentum_drift"] = drift
     noise = roundoff(c, t, q, qd, params, T, [w_nc, w_drive])[:measured]
     if "energy" in conserved:
-        said = _accuracy_warning(req, "E", E - E[0], E[0], T, t, qd, c, measured, noise)
+        said = _accuracy_warning(req, "E", E - E[0], E[0], T, t, qd, c, measured, noise, params)
     elif c.jacobi is not None:
         said = _accuracy_warning(
-            req, "The Jacobi integral h", h - h[0], h[0], T, t, qd, c, measured, noise
+            req, "The Jacobi integral h", h - h[0], h[0], T, t, qd, c, measured, noise, params
         )
     else:
-        said = _accuracy_warning(req, _BALANCE, balance, None, T, t, qd, c, measured, noise)
+        said = _accuracy_warning(req, _BALANCE, balance, None, T, t, qd, c, measured, noise, params)
     warnings += [said] if said else []
     warnings += _singularity_warnings(c, t, q, qd, params)
     if req.check_sensitivity and METHODS[req.method].kind == "adaptive" and raw.status == "ok":
@@ -630,7 +631,8 @@ def _accuracy_warning(
     qd: np.ndarray,
     c: CompiledScene,
     measured: int,
-    noise: np.ndarray | None = None,
+    noise: np.ndarray | None,
+    params: list[float],
 ) -> str | None:
     """The sentence on a run whose conserved quantity (or energy balance) strayed by more than
     ENERGY_WARNING, true to what the error did: a symplectic method's error oscillates and stays
@@ -676,7 +678,7 @@ def _accuracy_warning(
         lo, hi = float(np.min(error)), float(np.max(error))
         if start is not None:
             lo, hi = lo + start, hi + start
-        symplectic = method.symplectic and constant_mass_matrix(c)
+        symplectic = method.symplectic and why_not_symplectic(c, params) is None
         why = "a symplectic method's bounded error" if symplectic else "a bounded error"
         return (
             f"{name} oscillates between {_apart(lo, hi, lo)}{unit} and {_apart(hi, lo, hi)}{unit}, "
@@ -693,14 +695,15 @@ def _accuracy_warning(
         )
     when = f"by t = {t[worst]:.3g} s"
     if trend == "grows":
-        if method.symplectic and not constant_mass_matrix(c):
+        not_here = why_not_symplectic(c, params) if fixed else None
+        if method.symplectic and not_here:
             better = (
-                f"take {shrink} or a higher-order method ({req.method} is symplectic only "
-                "when the mass matrix is constant, and this scene's depends on the coordinates)"
+                f"take {shrink} or a higher-order method ({req.method} is not symplectic here: "
+                f"{not_here})"
             )
         elif method.symplectic:
             better = f"take {shrink}"
-        elif fixed and constant_mass_matrix(c):
+        elif fixed and not not_here:
             better = (
                 f"take {shrink}, or a symplectic method (symplectic_euler, implicit_midpoint) "
                 "whose energy error stays bounded for this scene's constant mass matrix"
@@ -714,6 +717,61 @@ def _accuracy_warning(
             f"length of the run: {better}."
         )
     return f"{name} {change} {when}, {of_scale}: ask for {shrink} or a higher-order method."
+
+
+def why_not_symplectic(c: CompiledScene, params: list[float]) -> str | None:
+    """Why symplectic Euler and the implicit midpoint step do not keep a modified energy on this
+    motion, in the words the page shows; None where they do. One rule for every claim of a
+    bounded energy error (the methods' rows, the long run).
+
+    They do on the flow of a Hamiltonian H(q, p) free of t, stepped in variables that are a
+    linear change of (q, p): L free of t, no power of the non-conservative forces (judged at
+    these parameters: a damper with c = 0 does no work), M constant (p = M q̇), and q̈ free of
+    q̇ (their explicit update of q̇ is the symplectic one only for forces of q alone). A damped,
+    driven or rubbing motion conserves no energy at all (the error measured is the energy
+    balance's), so there is nothing for a modified energy to stay close to."""
+    m, work = c.derivation.model, c.derivation.work
+    values = {
+        m.params[name]: sp.Rational(repr(float(v)))
+        for name, v in zip(c.parameters, params, strict=True)
+    }
+    Q = [_expr(q).xreplace(values) for q in work.Q]
+    power = sp.expand(sum((q * qd for q, qd in zip(Q, m.qd, strict=True)), sp.S.Zero))
+    if not vanishes(power, m):
+        return (
+            "non-conservative forces do work on this motion (a damper, friction or a driving "
+            "force: Σ Q_j q̇_j ≠ 0), so its energy is not conserved and there is no conserved "
+            "energy for symplectic Euler to stay close to; the error shown is that of the energy "
+            "balance ΔT + ΔV − W_NC, which is not bound to stay bounded"
+        )
+    if explicit_time(work.L.xreplace(values), m):
+        return (
+            "L depends explicitly on t (a driven or moving support), so no energy is conserved "
+            "and there is no fixed Hamiltonian whose modified version symplectic Euler could keep"
+        )
+    if not constant_mass_matrix(c):
+        return (
+            "the mass matrix changes with the coordinates, so symplectic Euler, which steps q and "
+            "q̇ rather than the momenta p = M(q) q̇, is not symplectic here: its energy error is "
+            "not bound to stay bounded"
+        )
+    forcing = work.forcing if work.forcing is not None else work.accelerations
+    if forcing is None:
+        return "the equations were too large to check whether the forces depend on q̇ or on t"
+    for f in forcing:
+        f = _expr(f).xreplace(values)
+        if f.has(*m.qd) or explicit_time(f, m):
+            return (
+                "the forces depend on the velocities (a gyroscopic force, like a magnetic one), "
+                "and symplectic Euler's explicit update of q̇ is not the symplectic map of such "
+                "a flow"
+            )
+    return None
+
+
+def _expr(x: Any) -> sp.Expr:
+    """A sympy number or expression as it is; a plain 0 (a Q_j no force contributes to) as one."""
+    return x if isinstance(x, sp.Basic) else sp.Integer(x)
 
 
 def constant_mass_matrix(c: CompiledScene) -> bool:

@@ -80,7 +80,7 @@ def test_symplectic_euler_drifts_on_a_coordinate_dependent_mass_matrix():
     assert E[0] - E.min() > 10  # independently: tens of joules lost, not an oscillation
     said = _energy_warning(d)
     assert "oscillates" not in said and "symplectic method's bounded" not in said
-    assert "only when the mass matrix is constant" in said
+    assert "not symplectic here: the mass matrix changes with the coordinates" in said
 
 
 def test_explicit_euler_advice_names_symplectic_methods_on_a_constant_mass_matrix():
@@ -117,3 +117,25 @@ def test_sensitivity_rtols_differ_at_rtol_1e_3():
     assert pairs, d["warnings"]
     for p in pairs:
         assert float(p.group(1)) != float(p.group(2))
+
+
+def test_no_symplectic_remedy_is_offered_for_a_damped_oscillator():
+    """A damper does work: no energy is conserved, so symplectic Euler has no modified energy
+    to keep (work–precision and this warning follow one rule, simulate.why_not_symplectic)."""
+    d = _run("spring_mass_damper", "euler", 0.05, 20)
+    said = [w for w in d["warnings"] if "drifts" in w or "strays" in w or "reached" in w]
+    assert len(said) == 1, d["warnings"]
+    assert "symplectic_euler" not in said[0] and "symplectic method" not in said[0]
+    # the same advice where the damper and the drive are off: then it is offered
+    off = simulate(
+        "spring_mass_damper",
+        None,
+        SimulationRequest(
+            method="euler",
+            dt=0.05,
+            t_end=20,
+            check_sensitivity=False,
+            parameters={"c": 0.0, "F0": 0.0},
+        ),
+    )
+    assert any("symplectic_euler" in w for w in off["warnings"]), off["warnings"]

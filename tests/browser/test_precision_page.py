@@ -8,6 +8,7 @@ yet (``precision_app``, a uvicorn factory), so the test does not depend on the w
 from __future__ import annotations
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -105,7 +106,8 @@ def test_run_shows_fitted_orders_near_the_textbook_orders(panel_page):
     for plot in ("time", "evals", "energy", "long"):
         assert page.locator(f"#precision-plot-{plot} .main-svg").count() >= 1, plot
     long_text = page.inner_text("#precision-long")
-    assert "1000 periods" in long_text and "symplectic Euler" in long_text
+    # as many periods as the 4.5 s budget allows (100 to 1000): the page says how many
+    assert re.search(r"\b\d{3,4} periods", long_text) and "symplectic Euler" in long_text
     assert "Done in" in page.inner_text("#precision-status")
     assert not errors, errors
 
