@@ -58,8 +58,12 @@ function markStale() {
         continue;
       }
       part.dataset.stale = reason;
-      const text = "Greyed: these are the last run's numbers, not the values now set, which the " +
-        `server refused (${reason.replace(/^The simulation failed:\s*/, "")}).`;
+      const why = reason.replace(/^The simulation failed:\s*/, "");
+      const what = canvas.dataset.errorFrom === "page"
+        ? `the page failed to show the run for (${why})` : `the server refused (${why})`;
+      const text = canvas.dataset.hadRun === "0"
+        ? `Greyed: no run has been shown yet; the values now set are ones ${what}.`
+        : `Greyed: these are the last run's numbers, not the values now set, which ${what}.`;
       const out = note || Object.assign(document.createElement("p"), { className: "stale-note" });
       out.setAttribute("role", "status");
       out.textContent = text;

@@ -8,7 +8,7 @@
 // the server's run (the measured one, which the integrator panel, plots and compare mode show)
 // replaces it; the server is asked when a slider is let go.
 import {
-  busy, getJSON, holdMathJax, postJSON, prerenderedMath, releaseMathJax, track, typeset,
+  ApiError, busy, getJSON, holdMathJax, postJSON, prerenderedMath, releaseMathJax, track, typeset,
 } from "./api.js";
 import { keepAnchor } from "./anchor.js";
 import { buildControls, readValues, setControl, writeQuery } from "./controls.js";
@@ -289,6 +289,10 @@ class SceneView {
     } catch (err) {
       if (id !== this.runs) return;
       showWarnings([`The simulation failed: ${err.message}`]);
+      // what the greyed panels say (page.js): whether numbers of an earlier run are on them, and
+      // whether the server refused the values or the page failed to show its answer
+      $("canvas").dataset.errorFrom = err instanceof ApiError ? "server" : "page";
+      $("canvas").dataset.hadRun = this.result ? "1" : "0";
       $("canvas").dataset.error = err.message;
       if (this.shown && this.shown.stats.preview) { // never leave a preview of a refused state
         this.shown = null;

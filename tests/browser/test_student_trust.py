@@ -262,3 +262,17 @@ def test_lecture_modes_provenance_words_wrap_in_the_column(server, page, sized, 
     header = p.locator(".pv-table th", has_text="right side minus").first
     assert header.is_visible()
     assert p.evaluate(PAST_THE_COLUMN) == []
+
+
+def test_a_page_opened_on_refused_values_says_no_run_was_shown(server, page):
+    """A link with m = 0 (hostile play-test: ?l=1e308…): there never was a run, so the greyed
+    panels must not claim to hold 'the last run's numbers'."""
+    p = page.page
+    p.goto(f"{server}/scenes/simple_pendulum?m=0")
+    p.wait_for_function("document.querySelector('#canvas').dataset.error", timeout=60_000)
+    page.settle()
+    notes = p.eval_on_selector_all(".stale-note", "ns => ns.map(n => n.textContent)")
+    assert notes
+    for note in notes:
+        assert "no run has been shown yet" in note and "server refused" in note, note
+        assert "last run" not in note
