@@ -265,7 +265,18 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             "above."
         )
     elif not dry and not any(w.startswith(_EDGE) for w in warnings):
-        warnings.append("No equilibrium: the forces at rest never balance at these parameters.")
+        kinked = any(
+            k.args[0].has(*m.q) for c in conditions for k in (sp.S.Zero + c).atoms(sp.Abs, sp.sign)
+        )
+        warnings.append(
+            # a force −k sgn(x − y) balances on the kink x = y only, where no slope leads
+            "No equilibrium found, but the forces at rest have kinks (|u| or sgn(u) of the "
+            "coordinates): a point on a kink of several coordinates, or one where the forces on "
+            "either side point toward it (0 lies between their one-sided values) is not "
+            "searched for, and there may be one there."
+            if kinked
+            else "No equilibrium: the forces at rest never balance at these parameters."
+        )
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
 
 
@@ -1279,28 +1290,38 @@ class _System:
         return edge & others
 
 
-def _kink_points(m: Any, eqs: list, bound: list[int], values: dict) -> np.ndarray:
-    """In one coordinate, the points where an argument of |u| or sgn(u) in the conditions
-    vanishes: a force −k sgn(x) balances at x = 0 only, where Newton has no slope to follow
-    (V = k|x| was 'no equilibrium'). Candidates only: the residual decides."""
-    if len(bound) != 1:
-        return np.zeros((len(bound), 0))
-    q = m.q[bound[0]]
-    x = sp.Dummy("x", real=True)
+def _kink_points(m: Any, eqs: list, bound: list[int], values: dict) -> list[tuple[int, float]]:
+    """Where an argument of |u| or sgn(u) in the conditions vanishes, for u linear in one
+    coordinate: (index among the bound ones, value). A force −k sgn(x) balances at x = 0 only,
+    where Newton has no slope to follow (V = k|x| was 'no equilibrium'): the search's points
+    are snapped there too. Candidates only: the residual decides."""
+    xs = {m.q[j]: i for i, j in enumerate(bound)}
     numbers = {p: sp.Float(v) for p, v in values.items()}
     kinks = set().union(*((sp.S.Zero + e).atoms(sp.Abs, sp.sign) for e in eqs))
-    points: list[float] = []
+    points: list[tuple[int, float]] = []
     for kink in sorted(kinks, key=sp.default_sort_key)[:8]:
-        u = kink.args[0].xreplace({q: x}).xreplace(numbers)
-        if u.free_symbols != {x} or sp.count_ops(u) > 40:
+        u = kink.args[0].xreplace(numbers)
+        inside = [q for q in xs if u.has(q)]
+        if len(inside) != 1 or sp.count_ops(u) > 40:
+            continue
+        x = sp.Dummy("x", real=True)
+        u = u.xreplace({inside[0]: x})
+        if u.free_symbols != {x}:
             continue
         try:
             slope = u.diff(x)
             if not slope.free_symbols and slope != 0:  # linear in x: one root
-                points.append(float(-u.xreplace({x: 0}) / slope))
+                points.append((xs[inside[0]], float(-u.xreplace({x: 0}) / slope)))
         except (TypeError, ValueError):
             continue
-    return np.array([points]).reshape(1, -1) if points else np.zeros((1, 0))
+    return points
+
+
+def _snapped(X: np.ndarray, kinks: list[tuple[int, float]]) -> np.ndarray:
+    """The search's points with one coordinate put on a kink: the others found by Newton."""
+    return np.hstack(
+        [X] + [np.vstack([*X[:i], np.full(X.shape[1], c), *X[i + 1 :]]) for i, c in kinks]
+    )
 
 
 @functools.lru_cache(maxsize=512)
@@ -1382,7 +1403,10 @@ def _numeric_search(system: _System) -> list[list[float]]:
         if not active.any():
             break
     alive = np.all(np.isfinite(X), axis=0)
-    X = np.hstack([X[:, alive], system.kinks])
+    X = X[:, alive]
+    if system.kinks:  # every start once more, put on the kink, and where Newton ended
+        start = _starts(system).T
+        X = _snapped(np.hstack([X, start[:, np.all(np.isfinite(start), axis=0)]]), system.kinks)
     balanced = system.residual_ok(X)
     edge = balanced & ~system.in_range(X) & system.on_edge(X)
     for x in X[:, edge].T[:1]:

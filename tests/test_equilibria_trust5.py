@@ -335,3 +335,20 @@ def test_a_free_centre_of_mass_is_not_hidden_behind_positive_definite():
     assert "positive definite off" in e["reason"]
     k, c, m = 10.0, 0.5, 1.0
     assert e["frequencies"] == pytest.approx([math.sqrt(2 * k / m - (c / m) ** 2)], rel=1e-9)
+
+
+def test_a_kink_in_one_of_two_coordinates_is_found_and_not_overclaimed():
+    """V = k|x| + k y²: the forces −k sgn x, −2k y balance at (0, 0) only (was 'no
+    equilibrium'); in two coordinates no sampling proves the minimum, so it is marginal with
+    the reason why. V = k|x − y| + k(x + y)²: its equilibrium (0, 0) lies on a kink of two
+    coordinates, which the search does not follow: 'never balance' would be false."""
+    spec = kinked("k*abs(x) + k*y**2") | {"coordinates": ["x", "y"]}
+    spec["bodies"] = [{"name": "b", "mass": "m", "position": ["x", "y", 0]}]
+    (e,) = equilibria(derive_model(spec))["equilibria"]
+    assert e["q"] == {"x": 0.0, "y": 0.0}
+    assert e["kind"] == "marginal" and "no linearization" in e["reason"]
+    spec["potentials"] = [{"name": "V", "expression": "k*abs(x-y) + k*(x+y)**2"}]
+    out = equilibria(derive_model(spec))
+    if not out["equilibria"]:
+        assert not any("never balance" in w for w in out["warnings"])
+        assert any("kinks" in w for w in out["warnings"])
