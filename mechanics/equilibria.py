@@ -1492,6 +1492,9 @@ class Power:
 
     kind: str = "none"
     text: str = ""
+    #: "no sign" proven never negative (c ẋ⁴ of an anti-damper c ẋ³): energy is fed in, not
+    #: merely possibly fed in.
+    feeds: bool = False
     #: The sum the text equates, as LaTeX (the general one when the scene's is not known).
     symbol: str = r"\sum_j (Q_j^{NC} - Q_j^{NC}|_{\dot q = 0})\,\dot q_j"
 
@@ -1562,7 +1565,16 @@ def _power_at(d: Derivation, values: dict, q0: list[float]) -> Power:
         text += " (dampers aside)"
     if proven or _quadratic_wins(m, at, q0):
         return Power("dissipative", text, symbol)
-    return Power("no sign", text, symbol)
+    feeds = _once(d, "never negative", at, lambda: _never_positive(m, -at))
+    return Power("no sign", text, symbol, feeds)
+
+
+def _sign_words(power: Power) -> str:
+    """What a power that is not ≤ 0 does, as proven: c ẋ⁴ is never negative (energy is fed in
+    whenever the body moves); a power of either sign can feed energy in."""
+    if power.feeds:
+        return "is never negative: they feed energy in whenever the system moves"
+    return "has no sign: they can feed energy in"
 
 
 def _never_positive(m: Any, power: sp.Expr) -> bool:
@@ -1771,7 +1783,7 @@ def _kink_verdict(d: Derivation, v: Variant, q0: list[float], values: dict, powe
                 "marginal",
                 f"{_KINK_NO_LINEAR}; the force pushes back toward it from both sides (the "
                 f"potential has a minimum with a kink here), but the velocity-dependent forces' "
-                f"power {power.text} has no sign: they can feed energy in, so the minimum need "
+                f"power {power.text} {_sign_words(power)}, so the minimum need "
                 "not hold the motion",
                 [],
                 [],
@@ -2208,7 +2220,7 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
             f"$\\mathbf K$ is positive definite (the {_potential(turning)} has a minimum here) and "
             "no "
             f"eigenvalue has positive real part ({shown}), but the velocity-dependent forces' "
-            f"power {power.text} has no sign: they can feed energy in, which the "
+            f"power {power.text} {_sign_words(power)}, which the "
             "linearization does not see, so the minimum need not hold the motion "
             "(Lagrange–Dirichlet needs forces that do no positive work) and the linear test "
             f"cannot decide{free_note}",
