@@ -212,5 +212,5 @@ def test_a_slow_answer_shows_progress_saying_what_it_waits_for(server, fresh):
     assert bar.get_attribute("role") == "progressbar"
     assert "Finding equilibria" in bar.inner_text()
     held.release()
-    bar.wait_for(state="hidden", timeout=30_000)
+    bar.wait_for(state="hidden", timeout=90_000)  # the run and the equilibria, on a loaded machine
     assert page.get_attribute("html", "data-slow") is None

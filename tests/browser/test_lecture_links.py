@@ -56,6 +56,7 @@ PUNCTUATION_AFTER_MATH = r"""() => {
 }"""
 
 
+@pytest.mark.timeout(300)  # 36 widths, each refitting the equations: ~40 s quiet, 180 s at load 16
 def test_punctuation_stays_with_the_math_before_it(server, browser):
     with projector(browser, 1024, 768) as (p, errors):
         open_lecture(p, f"{server}/scenes/double_pendulum?lecture=1&step=99")
