@@ -543,12 +543,13 @@ class SceneView {
       el.style.visibility = hide ? "hidden" : "";
     });
     if (window.MathJax) items.forEach((item) => raw(item, true));
-    // the ready-made math, unless its file is slow to come: then MathJax typesets it all
-    await Promise.race([this.prerendered, new Promise((resolve) => setTimeout(resolve, PRERENDERED_WAIT_MS))]);
     const done = busy("Typesetting the equations…");
     const view = watchInView(items);
     try {
-      await view.ready;
+      // which steps are in view, and the ready-made math (unless its file is slow to come: then
+      // MathJax typesets it all), waited for together
+      await Promise.all([view.ready, Promise.race([this.prerendered,
+        new Promise((resolve) => setTimeout(resolve, PRERENDERED_WAIT_MS))])]);
       // A derivation out of sight waits for the animation to move; one in view (lecture mode, a
       // link to it) is what the reader came for, so it starts at once.
       if (items.some((item) => view.has(item))) releaseMathJax();
