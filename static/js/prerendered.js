@@ -4,7 +4,8 @@
 // steps held the main thread for 0.4–0.9 s). Looked up by the exact TeX, display mode and font
 // size (MathJax's smallest script size is in pixels: a subscript's subscript is drawn a little
 // differently at 16 px and at lecture mode's 24 px), so a derivation whose text changed since
-// simply misses and is typeset live: a stale file can cost time, never show other math. Tests check that the files cover every built-in derivation and
+// simply misses and is typeset live: a stale file can cost time, never show other math. Tests
+// check that the files cover every built-in derivation (tests/test_prerendered_files.py) and
 // equal what MathJax renders now (tests/browser/test_prerendered_math.py).
 //
 // The ready-made equations have no MathJax menu behind them (no speech, no explorer): the first
@@ -95,7 +96,7 @@ function container(html, tex, display) {
   const tpl = document.createElement("template");
   tpl.innerHTML = html;
   const node = tpl.content.firstElementChild;
-  node.dataset.tex = tex; // what the equation says, as the copy buttons and tests read it
+  node.dataset.tex = tex; // what the equation says (MathJax keeps it in its items; tests read it)
   node.dataset.display = display ? "true" : "false";
   node.dataset.prerendered = "";
   return node;
