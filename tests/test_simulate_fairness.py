@@ -185,12 +185,16 @@ def test_a_flood_from_one_client_neither_fails_nor_delays_another(server):
     assert max(small) < 1.0, small
     statuses = [status for status, _, _ in answers]
     assert set(statuses) <= {200, 503}, statuses
-    ran = [body for status, body, _ in answers if status == 200]
+    ran = [(body, took) for status, body, took in answers if status == 200]
     refused = [(body, took) for status, body, took in answers if status == 503]
-    # one at a time: those that started within the start budget ran, each to its own wall time
-    assert 1 <= len(ran) <= START_SECONDS / WALL_SECONDS + 2, statuses
-    assert len(refused) >= FLOOD - len(ran)
-    for body in ran:
+    assert ran, statuses
+    # one at a time, each to its own wall time: the last to finish waited for all the others
+    assert max(took for _, took in ran) >= 0.9 * WALL_SECONDS * len(ran), statuses
+    # and none waited for its turn past the start budget (the count that ran depends on when the
+    # 45 requests reached the server, which a loaded machine staggers: 6 ran once, not 3 or 4)
+    for body, took in ran:
+        assert took - body["stats"]["wall_time"] < START_SECONDS + 2.0, (took, statuses)
+    for body, _ in ran:
         assert body["stats"]["status"] != "ok"
         assert body["stats"]["wall_time"] >= 0.9 * WALL_SECONDS  # its full budget, not less
         warnings = " ".join(body["warnings"])

@@ -28,10 +28,11 @@ def test_sliders_and_line_captions_show_symbols_with_their_names_on_hover(server
     assert row.locator(".name").inner_text() == "θ̇₁"
     assert row.locator("label").get_attribute("title") == "theta1_dot"
     line = p.locator("#steps .math-line[data-label='dL/dtheta1_dot']")
-    assert line.locator(".line-label").inner_text() == "∂L/∂θ̇₁"
+    # text_content: a step out of sight is not rendered (content-visibility), so no innerText
+    assert line.locator(".line-label").text_content() == "∂L/∂θ̇₁"
     assert line.locator(".line-label").get_attribute("title") == "dL/dtheta1_dot"
     eom = p.locator("#steps .math-line[data-label='EoM theta2'] .line-label")
-    assert eom.inner_text() == "EoM θ₂"
+    assert eom.text_content() == "EoM θ₂"
     options = p.eval_on_selector_all("#phase-q option", "os => os.map((o) => [o.value, o.text])")
     assert options == [["theta1", "θ₁"], ["theta2", "θ₂"]]
 
