@@ -570,8 +570,14 @@ class SceneView {
           raw(item, false);
           item.dataset.typeset = "1";
         });
-        // a task of its own per batch: a frame due meanwhile is drawn between two batches
-        await new Promise((resolve) => setTimeout(resolve, 0));
+        // a frame between two batches: the animation's is drawn, and the observer reports where
+        // the steps are now that this batch changed their heights (else the next batch is
+        // chosen by the old positions: the steps above a reader at the end came before the
+        // ones on screen); at most 50 ms, for a tab in the background that draws no frames
+        await new Promise((resolve) => {
+          const timer = setTimeout(resolve, 50);
+          requestAnimationFrame(() => setTimeout(() => { clearTimeout(timer); resolve(); }, 0));
+        });
       }
     } finally {
       view.stop();
