@@ -142,7 +142,10 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     found: list[tuple[Derivation, Root]] = []
     everywhere = Variant(m, d.work.mass_matrix, d.work.forcing, [])
     if len(_once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]) > 1:
-        # the step shows every side's conditions as derived, whatever is 0 at these values
+        # the step shows every side's conditions as derived, whatever is 0 at these values, in
+        # place of the general ones (which are the first side's, shown twice with and without
+        # its label)
+        del steps[0].lines[-len(m.q) :]
         for variant in _once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]:
             conds = _once(d, "at rest", ((), variant.label), functools.partial(_at_rest, variant))
             steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
@@ -152,6 +155,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     families: list[str] = []
     if idle:
         families.append(_idle_note(m, idle, len(idle) == len(m.q)))
+    numeric_only: dict[str, list[Root]] = {}  # why sympy gave no closed form → roots searched
     for variant in variants:
         if variant.label and len(variants) > 1:
             key = (zeros, variant.label)
@@ -161,15 +165,19 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
         conds = [_drop_idle_drive(d, c, values) for c in conds]
         conds = [sp.S.Zero if j in idle else c for j, c in enumerate(conds)]
         try:
-            roots, notes = _equilibrium_points(variant, conds, values, periods)
+            roots, notes, why = _equilibrium_points(variant, conds, values, periods)
         except _ConditionsOverflow as exc:
             raise _beyond_doubles(d, parameters or {}, exc.q0, exc) from None
         for note in notes:
             if note not in warnings:
                 warnings.append(note)
+        searched = numeric_only.setdefault(why, []) if why is not None else []
         for root in roots:
             if not any(_same(root.numeric, r.numeric, periods) for _, r in found):
                 found.append((variant, root))
+                searched.append(root)
+    # one sentence per reason, over every side of the springs' anchors
+    warnings += [_numeric_note(why, roots) for why, roots in numeric_only.items()]
     found.sort(key=lambda vr: [abs(vr[1].numeric.get(j, 0.0)) for j in range(len(m.q))])
     if len(found) > MAX_EQUILIBRIA:
         warnings.append(
@@ -826,18 +834,21 @@ def _variants(d: Derivation, base: Variant, zeros: tuple) -> tuple[list[Variant]
 # --- the roots: closed form, checked and completed by a numeric search -----------------------
 
 
-def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], list[str]]:
+def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], list[str], str | None]:
+    """The roots, notes, and why sympy gave no closed form (None when it did): the caller says
+    that once, over every side of the springs' anchors (one sentence per side said 'each was
+    recognised in closed form' and 'none was' of the same system)."""
     m = v.model
     notes: list[str] = []
     free = [j for j, c in enumerate(conditions) if c == 0]
     bound = [j for j in range(len(m.q)) if j not in free]
     if not bound:
-        return [Root({}, {}, "always")], notes
+        return [Root({}, {}, "always")], notes, None
     to_zero = {m.q[j]: 0 for j in free}
     eqs = [conditions[j].xreplace(to_zero) for j in bound]
     family = _linear_family(m, eqs, bound, values)
     if family is not None and _in_range(v, family.numeric, values):
-        return [family], notes
+        return [family], notes, None
     system = _System(v, eqs, bound, values, periods)
     symbolic = _symbolic(m, eqs, bound, values, periods, _ranges(v, bound, to_zero))
     numeric = _numeric_search(system)
@@ -869,14 +880,14 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
             match.how = "closed form, confirmed numerically"
             confirmed += 1
             continue
-        closed = _closed_form_guess(m, eqs, bound, point, periods)
+        closed = _closed_form_guess(m, eqs, bound, point, periods, values)
         if closed is not None:
-            roots.append(Root(point, closed, "always", "numeric search, closed form recognised"))
+            # its exact value, not the search's (θ = −1.5·10⁻³⁶ was shown for θ = 0)
+            exact = {j: float(closed[j].xreplace(values)) for j in bound}
+            roots.append(Root(exact, closed, "always", "numeric search, closed form recognised"))
         else:
             roots.append(Root(point, {}, "numeric", "numeric search"))
-    if symbolic is None:
-        notes.append(_numeric_note(eqs, bound, roots))
-    elif len(roots) > len(symbolic):
+    if symbolic is not None and len(roots) > len(symbolic):
         notes.append(
             "The numeric search found equilibria that sympy's closed-form solution missed; "
             "they are listed too."
@@ -891,7 +902,7 @@ def _equilibrium_points(v, conditions, values, periods) -> tuple[list[Root], lis
         for edge in system.edges
         if not roots and _balanced_at_edge(v, conditions, edge, values, system.spread)
     ]
-    return roots, notes
+    return roots, notes, _numeric_why(eqs, bound) if symbolic is None else None
 
 
 def _balanced_at_edge(
@@ -1073,14 +1084,18 @@ def _not_asked(eqs: tuple, n: int) -> str:
     return ""
 
 
-def _numeric_note(eqs: list, bound: list[int], roots: list[Root]) -> str:
-    """What happened when sympy gave no closed form: not asked, or asked and failed; then the
-    search found the roots, and those it recognised (a simple value that satisfies the conditions
-    for any parameter values) carry a closed form. A note that said 'sympy could not' while
-    every entry showed one (the double pendulum's 0 and π) told the student two things."""
-    why = (
+def _numeric_why(eqs: list, bound: list[int]) -> str:
+    """Why there is no closed form: sympy not asked, or asked and failed."""
+    return (
         _not_asked(tuple(eqs), len(bound)) or "sympy could not solve the conditions in closed form"
     )
+
+
+def _numeric_note(why: str, roots: list[Root]) -> str:
+    """What happened when sympy gave no closed form (``why``): the search found the roots, and
+    those it recognised (a simple value that satisfies the conditions for any parameter values)
+    carry a closed form. A note that said 'sympy could not' while every entry showed one (the
+    double pendulum's 0 and π) told the student two things."""
     recognised = sum(1 for r in roots if r.symbolic)
     if not roots:
         return f"{why}, and a numeric search found no equilibrium."
@@ -1203,23 +1218,36 @@ def _existence(expr: sp.Expr) -> list[tuple[str, str]]:
     return out
 
 
-def _closed_form_guess(m, eqs, bound, point, periods) -> dict[int, sp.Expr] | None:
-    """A numeric root at a simple value (kπ/12 for an angle, 0 or ± a parameter otherwise) that
-    makes every condition vanish for any parameter values is a closed form that holds always."""
-    guesses, defaults = {}, _param_values(m)
+def _closed_form_guess(m, eqs, bound, point, periods, values) -> dict[int, sp.Expr] | None:
+    """A numeric root at a simple value (kπ/12 for an angle, 0 or ± a parameter, or twice one,
+    otherwise) that makes every condition vanish for any parameter values is a closed form that
+    holds always. Matched at the values asked for (a slider's), not the spec's defaults; every
+    match is tried (at M = 2, L0 = 1 the root x = −2 is −2 L0, not −M)."""
+    hits = []
     for j in bound:
         x = point[j]
         candidates = [sp.S.Zero]
         if j in periods:
             candidates += [sp.pi * k / 12 for k in range(-11, 13) if k]
-        else:
-            for p, v in m.spec.parameters.items():
-                candidates += [m.params[p], -m.params[p]] if abs(abs(x) - abs(v)) < 1e-6 else []
-        hit = [c for c in candidates if abs(float(c.xreplace(defaults)) - x) < 1e-7]
+        else:  # ± a parameter, or ± twice one (a spring's other side: x = −2ℓ₀)
+            for sym in m.params.values():
+                if float(values.get(sym, 0)) != 0:
+                    candidates += [sym, -sym, 2 * sym, -2 * sym]
+        hit = [c for c in candidates if abs(float(c.xreplace(values)) - x) < 1e-7]
         if not hit:
             return None
-        guesses[j] = hit[0]
-    exact = [e.xreplace({m.q[j]: guesses[j] for j in bound}) for e in eqs]
+        hits.append(hit)
+    for n, choice in enumerate(itertools.product(*hits)):
+        if n >= 16:  # a bound on the symbolic checks; past it the root stays a number
+            return None
+        guesses = dict(zip(bound, choice, strict=True))
+        if _holds_always(m, [e.xreplace({m.q[j]: guesses[j] for j in bound}) for e in eqs]):
+            return guesses
+    return None
+
+
+def _holds_always(m, exact: list[sp.Expr]) -> bool:
+    """Every condition vanishes at three random sets of parameter values."""
     rng = np.random.default_rng(1)
     for _ in range(3):
         trial = {s: sp.Float(rng.uniform(0.5, 2.0)) for s in m.params.values()}
@@ -1227,15 +1255,11 @@ def _closed_form_guess(m, eqs, bound, point, periods) -> dict[int, sp.Expr] | No
             try:
                 value = complex(e.xreplace(trial).evalf())
             except (TypeError, ValueError):
-                return None
+                return False
             scale = sum(abs(complex(a.xreplace(trial).evalf())) for a in sp.Add.make_args(e))
             if not abs(value) <= 1e-10 * (1 + scale):
-                return None
-    return guesses
-
-
-def _param_values(m) -> dict:
-    return {m.params[k]: sp.Float(v) for k, v in m.spec.parameters.items()}
+                return False
+    return True
 
 
 class _System:
