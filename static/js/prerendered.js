@@ -23,16 +23,18 @@ let adopting = null;
  * Use a prerendered-math file (fetched once; the page names it in a <link rel="preload">). A
  * missing or malformed file leaves every equation to be typeset live. `live(elements)` is the
  * ordinary typesetting, used to give an equation MathJax's menu when a reader asks for it.
+ * Resolves true once the table is in place (the derivation costs only its insertion), false when
+ * the math will be typeset live.
  */
 export async function usePrerendered(url, live) {
   try {
     const response = await fetch(url, { credentials: "same-origin" });
-    if (!response.ok) return;
+    if (!response.ok) return false;
     const data = await response.json();
     if (!data || typeof data.math !== "object" || !Array.isArray(data.html)
-      || typeof data.defs !== "string" || typeof data.css !== "string") return;
+      || typeof data.defs !== "string" || typeof data.css !== "string") return false;
     const defs = new DOMParser().parseFromString(data.defs, "image/svg+xml").documentElement;
-    if (defs.nodeName !== "svg") return;
+    if (defs.nodeName !== "svg") return false;
     defs.id = "MJX-SVG-prerendered-cache"; // the glyphs the <use> elements point at
     defs.setAttribute("aria-hidden", "true");
     document.body.prepend(document.importNode(defs, true));
@@ -42,8 +44,10 @@ export async function usePrerendered(url, live) {
     table = new Map(Object.entries(data.math).map(([key, i]) => [key, data.html[i]]));
     adopting = live;
     for (const type of ["focusin", "contextmenu"]) document.addEventListener(type, adopt, true);
+    return true;
   } catch {
     table = null; // typeset live, as without the file
+    return false;
   }
 }
 

@@ -76,7 +76,7 @@ class SceneView {
     holdMathJax(this.motion);
     // a built-in derivation's math, typeset ahead of time (prerendered.js), fetched meanwhile
     const ready = document.querySelector("link[data-prerendered-math]");
-    this.prerendered = ready ? prerenderedMath(ready.href) : Promise.resolve();
+    this.prerendered = ready ? prerenderedMath(ready.href) : Promise.resolve(false);
     if (this.sceneId) {
       derived = derivation || inline.derivation || postJSON("/api/v1/derive", this.target());
       derived.catch?.(() => {}); // shown by derive(); not an unhandled rejection meanwhile
@@ -548,14 +548,17 @@ class SceneView {
     try {
       // which steps are in view, and the ready-made math (unless its file is slow to come: then
       // MathJax typesets it all), waited for together
-      await Promise.all([view.ready, Promise.race([this.prerendered,
-        new Promise((resolve) => setTimeout(resolve, PRERENDERED_WAIT_MS))])]);
-      // A derivation out of sight waits for the animation to move; one in view (lecture mode, a
-      // link to it) is what the reader came for, so it starts at once.
+      const [, madeAhead] = await Promise.all([view.ready, Promise.race([this.prerendered,
+        new Promise((resolve) => setTimeout(() => resolve(false), PRERENDERED_WAIT_MS))])]);
+      // A derivation out of sight that MathJax must typeset waits for the animation to move (it
+      // would hold the main thread for half a second); ready-made math costs only its insertion,
+      // and an out-of-sight step is not even laid out (content-visibility), so it goes in at once
+      // (a formula it lacks still waits: MathJax itself is held until the motion). One in view
+      // (lecture mode, a link to it) is what the reader came for, so it starts at once.
       if (items.some((item) => view.has(item))) releaseMathJax();
-      else await this.motion;
+      else if (!madeAhead) await this.motion;
       const left = new Set(items);
-      const pace = typesetPace();
+      const pace = typesetPace(madeAhead);
       while (left.size) {
         // the steps in view first (again after each batch: the reader may have scrolled), then
         // the rest in order; a hidden step (lecture mode) is typeset too, ready when revealed
@@ -570,6 +573,7 @@ class SceneView {
           raw(item, false);
           item.dataset.typeset = "1";
         });
+        if (!left.size) break; // the last one: nothing more waits for a frame
         // a frame between two batches: the animation's is drawn, and the observer reports where
         // the steps are now that this batch changed their heights (else the next batch is
         // chosen by the old positions: the steps above a reader at the end came before the
@@ -693,9 +697,12 @@ function inlineData() {
  * about BATCH_MS of work each, at the pace this machine was seen to typeset. */
 const BATCH_MS = 50;
 
-function typesetPace() {
+function typesetPace(madeAhead) {
   const size = (item) => item.textContent.length || 1; // the LaTeX source: a proxy for the work
-  let msPerChar = null; // unknown until the first step was typeset
+  // unknown until the first step was typeset; ready-made math is only inserted (the double
+  // pendulum's seven steps took 40 ms in all, measured in the page): one batch, which learns
+  // the pace in case the file lacked some formulas and MathJax typesets them live
+  let msPerChar = madeAhead ? 0 : null;
   return {
     take(order) {
       if (msPerChar === null) return order.slice(0, 1);
@@ -715,7 +722,6 @@ function typesetPace() {
   };
 }
 
-/** A promise resolved by whoever gets there first; `pending` until then. */
 /** Which of `elements` are in (or just below) the viewport now, kept up to date as the reader
  * scrolls or lecture mode reveals a step; `ready` settles once each has been looked at once. */
 function watchInView(elements) {
@@ -736,6 +742,7 @@ function watchInView(elements) {
   return { ready, has: (el) => seen.has(el), stop: () => observer.disconnect() };
 }
 
+/** A promise resolved by whoever gets there first; `pending` until then. */
 function settleOnce() {
   let resolve;
   const p = new Promise((r) => { resolve = r; });

@@ -8,6 +8,8 @@ Each test opens its own browser context, so its cache starts empty.
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 pytestmark = pytest.mark.browser
@@ -163,8 +165,11 @@ ORDER_PROBE = """
 
 def test_the_steps_a_reader_looks_at_are_typeset_first(server, fresh):
     """A student who goes straight to the end of the derivation gets the Euler–Lagrange
-    equations typeset first, not after the free-body diagram they scrolled past."""
+    equations typeset first, not after the free-body diagram they scrolled past. The order
+    matters where MathJax typesets the steps live (a posted system, or a ready-made file that
+    did not come): the file is held back here."""
     fresh.add_init_script(f"({ORDER_PROBE})(true)")
+    fresh.route("**/math/*.json", lambda route: route.abort())
     page = fresh.new_page()
     page.goto(f"{server}/scenes/double_pendulum")
     _settled(page)
@@ -182,6 +187,48 @@ def test_the_steps_a_reader_looks_at_are_typeset_first(server, fresh):
     assert seen[-1] < len(seen) + 2, order
     first = [s for s, visible in order if visible]
     assert ids[-1] in first and ids[0] not in first, order
+
+
+#: Counts the observer's callbacks in which steps were marked typeset.
+BATCH_PROBE = """
+(() => {
+  window.__batches = [];
+  const seen = new Set();
+  new MutationObserver(() => {
+    const now = [...document.querySelectorAll('#steps li.step')]
+      .filter((li) => li.dataset.typeset === '1' && !seen.has(li));
+    now.forEach((li) => seen.add(li));
+    if (now.length) window.__batches.push(now.map((li) => li.dataset.step));
+  }).observe(document, { subtree: true, attributes: true, attributeFilter: ['data-typeset'] });
+})();
+"""
+
+
+def test_ready_made_math_goes_up_in_one_go_without_waiting_for_the_motion(server, fresh):
+    """With the math typeset ahead of time, a step costs only its insertion: the whole
+    derivation goes up in one task (no step half a second behind the others), and it does not
+    wait for the animation to move, which once put it 0.3 s past the 1.0 s target."""
+    fresh.add_init_script(BATCH_PROBE)
+    page = fresh.new_page()
+    # The motion held back: no server run, no preview, and the page's clock stopped, so the
+    # motion never comes and the page's deadline for it (a timer) never fires. A derivation
+    # that waited for either would never be typeset.
+    page.route("**/api/v1/simulate", lambda route: None)  # never answered
+    page.route("**/scenes/*/live.js*", lambda route: None)
+    page.clock.install()
+    page.clock.pause_at(time.time() + 1)  # (a second ahead: it cannot go back)
+    page.goto(f"{server}/scenes/double_pendulum", wait_until="commit")  # (no load event)
+    page.wait_for_selector("#steps[data-typeset='1']", state="attached", timeout=60_000)
+    assert page.evaluate("() => document.querySelector('#canvas').dataset.frame") is None
+    ids = page.eval_on_selector_all("#steps li.step", "els => els.map((e) => e.dataset.step)")
+    batches = page.evaluate("() => window.__batches")
+    assert len(batches) == 1 and sorted(batches[0]) == sorted(ids), batches
+    # every formula ready-made: none of them is a MathJax typeset of this visit
+    assert page.evaluate("() => document.querySelector('#steps mjx-container') !== null")
+    assert page.evaluate(
+        "() => [...document.querySelectorAll('#steps .math, #steps .text')]"
+        ".every((el) => !/\\\\[\\[(]/.test(el.textContent))"
+    )
 
 
 def test_a_link_to_the_derivation_keeps_its_place_and_typesets_what_it_shows(server, fresh):
