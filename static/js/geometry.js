@@ -2,8 +2,11 @@
 // which slide along a straight track (a floor, an incline), which hang on a rope from a pulley,
 // which ride a spinning hoop or a cone or a wire of any shape (swept from the spec's position at
 // the run's parameters), how big a rolling wheel is, where the supports are (fixed points only).
+// A rigid body hangs on a rod only when it is pinned (the anchor is a point of the body); else it
+// is drawn by its own shape and frame (rigid.js), on the surface it rolls on when it rolls.
 // Nothing here is scene-specific: every drawing decision is inferred from the data.
 import { compile } from "./expr.js";
+import { outline, rigidShape, rollingContacts } from "./rigid.js";
 
 export const COLORS = ["#1f6feb", "#d9480f", "#2f9e44", "#9c36b5", "#e8590c", "#0c8599"];
 const REL = 1e-6; // relative tolerance for "constant" along a run
@@ -120,6 +123,12 @@ export class SceneGeometry {
     this.wheels = new Map(); // rigid body -> radius (world units), inferred from rolling
     this.wires = []; // {body, anchor, frame, q, local: [[x, y, z]...] in the frame, from the anchor}
     this.surfaces = []; // {body, anchor, frame, lines: [local points...]}: a mesh of two sweeps
+    this.rolls = []; // {body, contacts, outward}: the curve a disk rolls on (world points)
+    this.shapes = new Map(); // rigid body -> its shape by its inertia (rigid.js), in its frame
+    for (const b of this.bodies) {
+      const shape = b.kind === "rigid_body" && b.frame && result.frames?.[b.frame] ? rigidShape(b, parameters) : null;
+      if (shape) this.shapes.set(b.name, shape);
+    }
     this.ranges = this.#ranges();
     for (const b of this.bodies) this.#analyze(b);
     // a wire or hoop turning about an axis in the picture's plane needs depth to be seen
@@ -229,13 +238,14 @@ export class SceneGeometry {
     const f = this.#positionFunction(body);
     if (!f || f.qs.length !== 1) return null;
     const q = f.qs[0], [lo, hi] = f.range(q);
-    const pts = [];
+    const pts = [], values = [];
     for (let k = 0; k < SWEEP; k++) {
-      const p = f.local({ [q]: lo + ((hi - lo) * k) / (SWEEP - 1) });
-      if (p.every(Number.isFinite)) pts.push(p);
+      const v = lo + ((hi - lo) * k) / (SWEEP - 1), p = f.local({ [q]: v });
+      if (p.every(Number.isFinite)) { pts.push(p); values.push(v); }
     }
     if (pts.length < 2) return null;
-    return { body: body.name, anchor: f.parts.anchor, frame: f.parts.frame, q, local: pts, closed: f.periodic(q) };
+    return { body: body.name, anchor: f.parts.anchor, frame: f.parts.frame, q, local: pts, closed: f.periodic(q),
+      values, place: (v) => f.local({ [q]: v }) };
   }
 
   /** The spec's position of a body as local (frame, from anchor) points of its coordinates, when
@@ -302,6 +312,11 @@ export class SceneGeometry {
     const d = w.local.map(norm);
     const mean = d.reduce((s, v) => s + v, 0) / d.length;
     const constant = mean > 1e-9 && Math.max(...d) - Math.min(...d) <= REL * mean;
+    // a rigid body not pinned at the anchor: its centre's circle is no rod (and no wire)
+    if (constant && !this.#pinned(body, w.anchor)) {
+      this.#rolling(body, w);
+      return;
+    }
     if (constant) {
       const flat = [0, 1, 2].find((k) => w.local.every((p) => Math.abs(p[k]) <= REL * mean));
       if (this.frameSpins(w.frame) && flat !== undefined) {
@@ -326,7 +341,62 @@ export class SceneGeometry {
       this.tracks.push({ body: w.body, origin: here, dir: dirW, lo: -0.2 * span, hi: 0.2 * span });
       return;
     }
+    if (body.kind === "rigid_body" && this.#rolling(body, w)) return;
     this.wires.push(w);
+  }
+
+  /**
+   * Whether a body turns about its anchor as about a pin: a particle at a constant distance is
+   * on a rod; a rigid body only when the anchor is a point of it. Its spec can say so (placed in
+   * its own frame from the anchor by constants: a physical pendulum); else the run must show the
+   * anchor fixed in the body's frame, seen from G, while the body moves (a one-sample sketch
+   * shows no motion: unsure, so no pin, and the body is drawn by its shape, not on a rod).
+   */
+  #pinned(body, anchor) {
+    if (body.kind !== "rigid_body") return true;
+    const parts = positionParts(body.position);
+    if (parts && body.frame && parts.frame === body.frame && parts.anchor === anchor) {
+      const comps = parts.components.map(compile);
+      if (comps.every((c) => c && ![...c.names].some((n) => n === "t" || this.coordinates.has(n)))) return true;
+    }
+    const run = this.result.sampled?.frames?.[body.frame] && this.result.sampled.positions?.[anchor]
+      ? this.result.sampled : this.result;
+    const F = run.frames?.[body.frame], G = run.positions?.[body.name], A = run.positions?.[anchor];
+    if (!F || !G || !A || run.t.length < 3) return false;
+    const world = run.t.map((_, i) => [A.x[i] - G.x[i], A.y[i] - G.y[i], A.z[i] - G.z[i]]);
+    const local = world.map((r, i) => [0, 1, 2].map((k) => dot(r, F[i].slice(3 * k, 3 * k + 3))));
+    const size = Math.max(...world.map(norm), 1e-12);
+    const moves = world.some((r) => norm(sub(r, world[0])) > 1e-6 * size);
+    return moves && local.every((r) => norm(sub(r, local[0])) <= 1e-4 * size);
+  }
+
+  /** A disk turning about N.z whose contact point stays on its rim along its centre's swept path
+   * (rigid.js rollingContacts): its radius from the motion, and the surface it rolls on. */
+  #rolling(body, w) {
+    const shape = this.shapes.get(body.name), frame = (this.spec.frames || []).find((f) => f.name === body.frame);
+    if (shape?.kind !== "disk" || shape.normal !== 2 || this.is3D || w.frame || !this.fixed.has(w.anchor)) return false;
+    if (!frame || (frame.parent ?? "N") !== "N" || frame.axis !== "z") return false;
+    const angleOf = compile(frame.angle);
+    if (!angleOf || angleOf.names.has("t")) return false;
+    const env = { ...this.parameters };
+    for (const [name, v] of Object.entries(this.result.q || {})) env[name] = v[0];
+    const angle = (v) => angleOf({ ...env, [w.q]: v });
+    const F0 = this.result.frames[body.frame][0], turn = angle(env[w.q]) - Math.atan2(F0[1], F0[0]);
+    if (!(Math.abs(turn - 2 * Math.PI * Math.round(turn / (2 * Math.PI))) < 1e-6)) return false;
+    const roll = rollingContacts(w.values, w.place, angle, shape.radius);
+    if (!roll) return false;
+    const o = this.at(w.anchor, 0);
+    this.wheels.set(body.name, roll.radius);
+    this.rolls.push({ body: body.name, contacts: roll.contacts.map((p) => add(o, p)), outward: roll.outward });
+    return true;
+  }
+
+  /** A rigid body's outline (rigid.js) in the world at sample i: through G, in its frame. */
+  outlineAt(name, i) {
+    const shape = this.shapes.get(name), body = this.bodies.find((b) => b.name === name);
+    const A = this.axesAt(body.frame, i), g = this.at(name, i);
+    return outline(shape, this.wheels.get(name) ?? null)
+      .map((p) => add(g, add(mul(A[0], p[0]), add(mul(A[1], p[1]), mul(A[2], p[2])))));
   }
 
   /** The body's position relative to `anchor`, in the axes of `frame`, at sample i. */
@@ -383,7 +453,7 @@ export class SceneGeometry {
           }
         }
       }
-      if (constant) {
+      if (constant && this.#pinned(body, anchor)) {
         this.links.push([anchor, name]);
         return;
       }
@@ -503,6 +573,11 @@ export class SceneGeometry {
     for (const r of this.pulleys.values()) sizes.push(2 * r);
     for (const h of this.hoops) sizes.push(2 * h.radius);
     for (const [a, b] of this.links) sizes.push(norm(sub(this.at(a, 0), this.at(b, 0))));
+    for (const name of this.shapes.keys()) {
+      if (this.links.some(([, b]) => b === name)) continue; // a pinned rod's length is its link's
+      const pts = this.outlineAt(name, 0);
+      sizes.push(Math.max(...pts.map((p) => norm(sub(p, pts[0])))));
+    }
     return Math.max(...sizes);
   }
 
@@ -558,6 +633,11 @@ export class SceneGeometry {
       const rim = [0, 0, 0];
       rim[c.axisIndex] = c.sign * h;
       around(add(apex, rim), r);
+    }
+    for (const r of this.rolls) pts.push(...r.contacts);
+    const linked = new Set(this.links.map(([, b]) => b));
+    for (const name of this.shapes.keys()) {
+      if (!linked.has(name)) for (const i of idx) pts.push(...this.outlineAt(name, i));
     }
     for (const [a, b] of this.links) {
       if (this.bodies.find((x) => x.name === b)?.kind !== "rigid_body") continue;

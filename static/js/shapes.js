@@ -2,6 +2,7 @@
 // render.js draws on a canvas or writes as SVG: the animation, the catalog drawings and the
 // free-body diagram all come from here.
 import { add, dot, mul, sub } from "./geometry.js";
+import { rigidBodyShapes, rollingSurfaceShapes } from "./rigid.js";
 
 const INK = "#343a40";
 const GROUND = "#868e96";
@@ -21,6 +22,10 @@ export function sceneShapes(geom, view, i, opts = {}) {
   if (geom.is3D && o.axes !== false) floorAndAxes(geom, view, out);
   grounds(geom, view, rad, out);
   for (const h of geom.hoops) hoop(geom, view, h, i, out);
+  for (const r of geom.rolls) {
+    const pts = r.contacts.map((p) => view.project(p).slice(0, 2));
+    out.push(...rollingSurfaceShapes(pts, r.contacts.map((p, k) => view.direction(p, r.outward[k]))));
+  }
   for (const sf of geom.surfaces) {
     for (const line of sf.lines) {
       const pts = geom.wireAt({ ...sf, local: line }, i).map((p) => view.project(p).slice(0, 2));
@@ -342,6 +347,12 @@ function body(geom, view, b, i, color, r, track, o, out, occupied) {
       const [ax, ay] = view.project(geom.at(link[0], i));
       out.push({ t: "line", a: [ax, ay], b: [2 * x - ax, 2 * y - ay], color, width: o.muted ? 6 : 9, cap: "round", alpha: o.muted ? 0.5 : 1 });
       out.push({ t: "circle", c: [x, y], r: 3.5, fill: "#fff", color: INK, width: 1.5 });
+      occupied.push([x - 6, y - 6, x + 6, y + 6]);
+      return;
+    }
+    const shape = geom.shapes.get(b.name);
+    if (shape && (shape.kind !== "disk" || !geom.wheels.has(b.name))) { // its own outline, through G
+      out.push(...rigidBodyShapes(shape, geom.outlineAt(b.name, i).map((p) => view.project(p).slice(0, 2)), [x, y], color, o.muted));
       occupied.push([x - 6, y - 6, x + 6, y + 6]);
       return;
     }
