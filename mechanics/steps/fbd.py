@@ -3,7 +3,9 @@
 Besides the applied forces, each body's constraint forces are named the way a textbook names them
 and placed where they act (`constraint_forces`), all of one family with the weight F_g: a rod's
 tension F_T at a bob, a track's or a wire's normal force F_N, a pin reaction F_pin at the pin, the
-normal force F_N and static friction F_f at a rolling contact, F_C for a resultant left unsplit.
+normal force F_N and static friction F_f at a rolling contact, a normal force F_N at each end of
+a rod that slides along a fixed line (a ladder's F_N,wall and F_N,floor), F_C for a resultant left
+unsplit when the contacts cannot be told from the kinematics and the inertia.
 Never a bare letter: T is the kinetic energy, N the inertial frame, R a disk's radius or a frame's
 name in the scenes. Only the names, the points and the directions come from here (kinematics
 alone); the sizes are Newton's (`mechanics.newton`, F_C = m a − ΣF along a run).
@@ -183,11 +185,14 @@ def _force(
 
 
 def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], str] | None:
-    """A planar rigid body moved by one coordinate: its constraints act at the point at rest.
+    """A planar rigid body moved by one coordinate: where its constraints act, when it can be told.
 
     The instantaneous centre P = G + ẑ × v_G / ω has zero velocity; if it is fixed in space it is
-    a pin (reaction F_pin), else the body rolls on the path P traces (normal force F_N across it,
-    static friction F_f along it — no slip, so friction is static).
+    a pin (reaction F_pin). Else the body rolls on the path P traces (normal force F_N across it,
+    static friction F_f along it — no slip, so friction is static) only if P is a point of the
+    body, on its rim (`_on_body`): every planar motion has a moving instantaneous centre, and a
+    sliding ladder's lies off the rod, where nothing touches it. Then its constraints act where
+    its points slide along fixed lines (`_sliding_ends`), or, not told, as a resultant (None).
     """
     moves = _moved_by(model, body.position, s)
     t = model.names["t"]
@@ -219,6 +224,8 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
             "work (though it is not perpendicular to "
             rf"$\partial \vec r_G/\partial {to_latex(q)}$ in general)"
         )
+    if not _on_body(model, body, centre, s):  # the centre of a sliding ladder, off the rod
+        return _sliding_ends(model, body, q, s)
     tangent = centre.diff(q, model.N)
     normal = model.N.z.cross(tangent)
     if tidy((body.position - centre).dot(normal), model).subs(s.states[0]) < 0:
@@ -248,6 +255,219 @@ def _rigid_contact(model: Model, body: Any, s: _Sampler) -> tuple[list[dict], st
         rf"no virtual work (though ${friction_label}$ is along "
         rf"$\partial \vec r_G/\partial {to_latex(q)}$)"
     )
+
+
+# ---------------------------------------------------------------------------- a body's extent
+#: Relative size below which a spread of mass counts as zero (a rod's thickness) or equal (round).
+SPREAD = 1e-9
+
+
+def _spreads(model: Model, body: Any, s: _Sampler) -> list[Any] | None:
+    """∫ r rᵀ dm about G in the plane of the motion (N.x, N.y), at each sampled state.
+
+    The spec gives no shape, only the central inertia; its spread in the plane is what it says
+    about where the mass is: ∫x² = (I_yy + I_zz − I_xx)/2, ∫xy = −I_xy. A rod has all its mass on
+    one line (one spread zero), a disk or a ring is round (the two equal).
+    """
+    import numpy as np
+
+    if body.inertia is None:
+        return None
+    N = model.N
+    rows = [s.values(body.inertia.dot(u)) for u in (N.x, N.y, N.z)]  # [i][state]: I·u_i in N
+    out = []
+    for ix, iy, iz in zip(*rows, strict=True):
+        sxx, syy = (iy[1] + iz[2] - ix[0]) / 2, (ix[0] + iz[2] - iy[1]) / 2
+        out.append(np.array([[sxx, -ix[1]], [-ix[1], syy]]))
+    return out
+
+
+def _components(v: Vector, model: Model, s: _Sampler) -> list[Any]:
+    import numpy as np
+
+    return [np.array(row[:2]) for row in s.values(v)]
+
+
+def _rod_axis(model: Model, body: Any, s: _Sampler) -> Vector | None:
+    """The unit vector along a rod (all its mass on one line through G in the plane), one of its
+    frame's axes; None for a body with breadth, or a rod along no axis of its frame."""
+    import numpy as np
+
+    spreads = _spreads(model, body, s)
+    if spreads is None:
+        return None
+    for S in spreads:
+        low, high = np.linalg.eigvalsh(S)
+        if high <= 0 or low > SPREAD * high:
+            return None
+    for axis in (body.frame.x, body.frame.y, body.frame.z):
+        if not s.zero(axis.dot(model.N.z) * model.N.z):
+            continue
+        across = _components(model.N.z.cross(axis), model, s)
+        if all(n @ S @ n <= SPREAD * np.trace(S) for n, S in zip(across, spreads, strict=True)):
+            return axis
+    return None
+
+
+def _on_body(model: Model, body: Any, centre: Vector, s: _Sampler) -> bool:
+    """Whether the moving point at rest is a point of the body where a surface can touch it.
+
+    A rod: P on its line (a plank rocking on a log rolls along itself). A round body (its mass
+    spread alike every way in the plane): P a fixed distance d from G, and I_zz between a solid
+    sphere's 2/5 m d² and a ring's m d², the round bodies that roll on a rim of radius d — a disk,
+    a cylinder, a ball, a hoop. Outside that band the body is not known to be a wheel of radius d:
+    a yo-yo's hub, or a square plate whose diagonal slides between a wall and a floor (P is a
+    corner's distance from G, I_zz = m d²/3, and no point of the plate is at P). Anything else is
+    not known to reach P either, so no rolling contact is claimed for it.
+    """
+    import numpy as np
+
+    rel = centre - body.position
+    axis = _rod_axis(model, body, s)
+    if axis is not None:
+        return s.zero(rel.cross(axis))
+    spreads = _spreads(model, body, s)
+    if spreads is None:
+        return False
+    for S in spreads:
+        size = np.trace(S)
+        if size <= 0 or abs(S[0, 0] - S[1, 1]) > SPREAD * size or abs(S[0, 1]) > SPREAD * size:
+            return False
+    d2 = tidy(rel.dot(rel), model)
+    if any(d2.has(q) for q in model.q) or d2.has(model.names["t"]):
+        return False
+    for S, st in zip(spreads, s.states, strict=True):
+        ring = float(body.mass.xreplace(st)) * float(d2.xreplace(st))  # m d²
+        if not (0.4 - SPREAD) * ring <= np.trace(S) <= (1 + SPREAD) * ring:
+            return False
+    return True
+
+
+def _line_direction(v: Vector, model: Model, s: _Sampler) -> Vector | None:
+    """The unit vector of v when its direction never changes with the coordinates (the velocity
+    of a point that slides along a fixed straight line), else None."""
+    import numpy as np
+
+    comps = [v.dot(u) for u in (model.N.x, model.N.y)]
+    k = int(np.argmax(np.abs(_components(v, model, s)[0])))
+    if not comps[k] or any(abs(x[k]) <= ZERO for x in _components(v, model, s)):
+        return None
+    ratios = [tidy(c / comps[k], model) for c in comps]
+    if any(r.has(q) for r in ratios for q in model.q) or any(
+        r.has(model.names["t"]) for r in ratios
+    ):
+        return None
+    size = sp.sqrt(tidy(sum(r**2 for r in ratios), model))
+    return sum(
+        (tidy(r / size, model) * u for r, u in zip(ratios, (model.N.x, model.N.y), strict=True)),
+        Vector(0),
+    )
+
+
+def _sliding_ends(model: Model, body: Any, q: Any, s: _Sampler) -> tuple[list[dict], str] | None:
+    """A rod whose point at rest is off it (a ladder between a wall and a floor): the two points of
+    it that slide along fixed straight lines are where its constraints act, each a normal force.
+
+    Found from the kinematics: a point G + σ ê of the rod moves on a straight line where its path
+    does not curve, (∂r/∂q × ∂²r/∂q²)·ẑ = 0 at every q — a quadratic in σ. Claimed only when that
+    gives two points on the rod (|σ| within a uniform rod's half-length √(3 ∫σ² dm / m)) sliding
+    along perpendicular lines, the two normal forces then being the two components of Newton's
+    resultant; else None, and only the resultant is drawn. One body only, so the lines' names (the
+    wall, the floor) label its forces without a clash.
+    """
+    axis = _rod_axis(model, body, s)
+    if axis is None or len(model.bodies) != 1:
+        return None
+    N, G = model.N, body.position
+    sigma = sp.Dummy("sigma")
+    r1 = (G + sigma * axis).diff(q, N)
+    bend = sp.expand(r1.cross(r1.diff(q, N)).dot(N.z))
+    coeffs = [bend.coeff(sigma, k) for k in (2, 1, 0)]
+    values = [[abs(float(c.xreplace(st))) for c in coeffs] for st in s.states]
+    lead = next((k for k in (0, 1) if all(v[k] > ZERO for v in values)), None)
+    if lead is None:
+        return None
+    monic = [tidy(c / coeffs[lead], model) for c in coeffs[lead:]]
+    if any(c.has(x) for c in monic for x in (*model.q, model.names["t"])):
+        return None
+    roots = [
+        tidy(r, model)
+        for r in sp.solve(
+            sum(c * sigma ** (len(monic) - 1 - k) for k, c in enumerate(monic)), sigma
+        )
+    ]
+    if len(roots) != 2:
+        return None
+    # a uniform rod's half-length squared, 3 ∫σ² dm / m, at each sampled state: how far it reaches
+    reach = [
+        3 * float(a @ S @ a) / float(body.mass.xreplace(st))
+        for a, S, st in zip(
+            _components(axis, model, s), _spreads(model, body, s), s.states, strict=True
+        )
+    ]
+    ends = []
+    for root in roots:
+        at = [complex(root.xreplace(st)) for st in s.states]
+        if any(abs(z.imag) > ZERO for z in at):
+            return None
+        if any(z.real**2 > (1 + SPREAD) * a2 for z, a2 in zip(at, reach, strict=True)):
+            return None
+        point = G + root * axis
+        along = _line_direction(point.diff(q, N), model, s)
+        if along is None:
+            return None
+        normal = N.z.cross(along)
+        if float((G - point).dot(normal).xreplace(s.states[0])) < 0:
+            normal = -normal
+        at_end = all(abs(z.real**2 - a2) <= SPREAD * a2 for z, a2 in zip(at, reach, strict=True))
+        ends.append((point, along, normal, at_end))
+    (p1, u1, n1, end1), (p2, u2, n2, end2) = ends
+    if not s.zero(n1.dot(n2) * N.z):
+        return None
+    names = [_surface(model, u, n, s) for u, n in ((u1, n1), (u2, n2))]
+    if names[0] == names[1] or "" in names:
+        names = ["1", "2"]
+    name = body.name
+    forces = []
+    for (point, _, normal, at_end), where in zip(ends, names, strict=True):
+        place = "its end" if at_end else "its point"
+        surface = f"the {where}" if where in ("wall", "floor", "ceiling") else "a fixed line"
+        forces.append(
+            _force(
+                "F_N",
+                name,
+                f"normal force of {surface} on {name}, at {place} that slides along it",
+                _point(point, model),
+                label_of=where,
+                part="rest",
+                along=_unit(normal, model),
+            )
+        )
+    points = "ends" if end1 and end2 else "points"
+    lines = (
+        f"along the {names[0]} and the {names[1]}"
+        if all(w in ("wall", "floor", "ceiling") for w in names)
+        else "along two perpendicular fixed straight lines"
+    )
+    first, second = forces[0]["label"], forces[1]["label"]
+    return forces, (
+        f"its {points} slide {lines}, and each is pushed across its line: the normal forces "
+        f"${first}$ and ${second}$ act there, each perpendicular to the only virtual "
+        "displacement of the point it acts at (along its line), so they do no virtual work "
+        "(smooth contacts, as the equations of motion assume: friction would be a declared force)"
+    )
+
+
+def _surface(model: Model, along: Vector, normal: Vector, s: _Sampler) -> str:
+    """A fixed line by what it is under gravity: a wall (vertical), a floor or a ceiling."""
+    if model.gravity is None:
+        return ""
+    down = model.gravity[1]
+    if s.zero(along.cross(down)):
+        return "wall"
+    if s.zero(along.dot(down) * model.N.z):
+        return "floor" if float(normal.dot(down).xreplace(s.states[0])) < 0 else "ceiling"
+    return ""
 
 
 def _coupled_to(model: Model, name: str, s: _Sampler) -> list[str]:
@@ -377,6 +597,14 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
                     " (the constraint moves with time, so it does do real work: a virtual "
                     "displacement is taken at fixed t)"
                 )
+        elif alone and body.frame is not None and [f["name"] for f in forces[name]] == ["F_C"]:
+            note = (
+                f"{name}: its only constraints are its own; it moves only with ${coords}$. Where "
+                "they act (contacts, a pin) the kinematics and the inertia do not tell, so only "
+                f"their resultant ${forces[name][0]['label']}$ is drawn, at its centre, with a "
+                "constraint moment; together they do no virtual work (ideal constraints, "
+                "eq. 18–20)"
+            )
         elif alone and body.kind == "particle" and not forces[name]:
             note = f"{name}: no constraint acts on it (it moves freely with ${coords}$)"
             if free == 2 and body.position.dot(model.N.z) == 0:
