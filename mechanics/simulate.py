@@ -500,6 +500,10 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     if c.drive is not None:
         (e_minus_h,) = evaluate(c.drive, t, q, qd, params)
         w_drive = e_minus_h - e_minus_h[0] + (y[:, 2 * n + 1] if c.extras > 1 else 0.0)
+    # E − h constant (the conserved step proved it: a puck on a turntable, E − h = Ω p_φ): the
+    # frame's drive does no work, though E − h ≠ 0 and W_drive is computed as rounding noise
+    verdict = next((s.data or {} for s in c.derivation.steps if s.id == "conserved"), {})
+    idle_drive = verdict.get("drive_work") == "none"
     stats: dict[str, Any] = {
         "method": req.method,
         "steps": run.nsteps,
@@ -509,7 +513,7 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
         "samples": len(t),
         "sample_interval": float(t_eval[1] - t_eval[0]) if len(t_eval) > 1 else None,
         "status": run.status,
-        "driven": c.drive is not None,
+        "driven": c.drive is not None and not idle_drive,
     }
     if METHODS[req.method].kind == "fixed":
         # the step the run took, dt to rounding (samples are whole steps apart); the asked dt

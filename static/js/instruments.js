@@ -225,7 +225,8 @@ export class Instruments {
       (datum ? `; here from V's lowest value in this run, min V = ${fmtJ(datum)} J: V′ = V − min V, ` +
         "E′ = E − min V = T + V′, and every energy bar starts at 0." : ".") +
       (works.length ? ` E − E₀ = ${works.join(" + ")}: the work done on the system.`
-        : this.result.stats?.driven ? " A drive does work here; its bar comes with the server's run."
+        : this.result.stats?.driven ? (this.result.stats.preview ? " A drive can do work here; its bar comes with the server's run."
+          : " A drive moves the system here, but it did no measurable work in this run: E stays constant.")
           : " No work is done from outside: E stays constant.");
   }
 
