@@ -454,7 +454,7 @@ def _sliding_ends(model: Model, body: Any, q: Any, s: _Sampler) -> tuple[list[di
         f"its {points} slide {lines}, and each is pushed across its line: the normal forces "
         f"${first}$ and ${second}$ act there, each perpendicular to the only virtual "
         "displacement of the point it acts at (along its line), so they do no virtual work "
-        "(smooth contacts, as the equations of motion assume: friction would be a declared force)"
+        "(smooth contacts, as the equations of motion assume)"
     )
 
 
