@@ -153,8 +153,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     warnings += notes
     idle = _idle_at(m, [_drop_idle_drive(d, c, values) for c in general], values)
     families: list[str] = []
+    inside = _inside_values(m, idle)
     if idle:
-        families.append(_idle_note(m, idle, len(idle) == len(m.q)))
+        families.append(_idle_note(m, idle, len(idle) == len(m.q), inside))
     numeric_only: dict[str, list[Root]] = {}  # why sympy gave no closed form → roots searched
     for variant in variants:
         if variant.label and len(variants) > 1:
@@ -190,7 +191,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = [], []
     left_out = False  # balanced where the system has no state: "never balance" would be false
     for variant, root in found:
-        q0 = [root.numeric.get(j, 0.0) for j in range(len(m.q))]
+        q0 = [root.numeric.get(j, inside.get(j, 0.0)) for j in range(len(m.q))]
         where = _undefined_position(m, q0, values)
         if where is not None:
             warnings.append(
@@ -254,6 +255,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
     results, verdicts = _one_per_configuration(m, results, verdicts, values, warnings)
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
+    results, verdicts = _where_the_stops_allow(d, results, verdicts, values, warnings)
     families += [v.family for v in verdicts if v.family and v.family not in families]
     steps.append(_stability_step(m, results, verdicts))
     dry = _once(d, "dry friction", "", lambda: _dry_friction(d))
@@ -488,8 +490,38 @@ def _zeroed(d: Derivation, zeros: tuple) -> Variant:
     return Variant(m, w.mass_matrix.applyfunc(zeroed), w.forcing.applyfunc(zeroed), [])
 
 
-def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
+def _inside_values(m: Any, idle: list[int]) -> dict[int, float]:
+    """The member of a family shown for each idle coordinate declared positive: its value 0,
+    shown for the others, is the edge the spec excludes (the turntable's r = 0 at k = mΩ², a
+    pole where the polar coordinates cannot linearize). Its initial value when that is inside,
+    else 1."""
+    out = {}
+    for j in idle:
+        name = m.coordinate_names[j]
+        if name in m.spec.positive_coordinates:
+            try:
+                start = float(m.spec.initial.get(name, 1.0))
+            except (TypeError, ValueError):
+                start = 1.0
+            out[j] = start if math.isfinite(start) and start > 0 else 1.0
+    return out
+
+
+def _idle_note(m: Any, idle: list[int], everything: bool, inside: dict[int, float]) -> str:
     names = ", ".join(m.coordinate_names[j] for j in idle)
+    shown = ", ".join(
+        f"{m.coordinate_names[j]} = {inside[j]:.4g}"
+        if j in inside
+        else f"{m.coordinate_names[j]} = 0"
+        for j in idle
+    )
+    excluded = (
+        " (0 is excluded: "
+        + ", ".join(m.coordinate_names[j] for j in inside)
+        + " is declared positive)"
+        if inside
+        else ""
+    )
     if everything:
         return (
             f"No force acts at rest at these parameters (every ${letter(m, 'Q')}_j$ "
@@ -500,7 +532,7 @@ def _idle_note(m: Any, idle: list[int], everything: bool) -> str:
     return (
         f"At these parameters no force acts at rest along {names} (its $Q$ vanishes for every "
         f"value of it): every value of {names} is an equilibrium (a family); the list shows "
-        f"{names} = 0 of each."
+        f"{shown} of each{excluded}."
     )
 
 
@@ -565,6 +597,42 @@ def _inside_the_model(m, results, verdicts, values, warnings):
             f"{'is' if len(out) == 1 else 'are'} left out."
         )
     return [r for r, _, _ in kept], [v for _, v, _ in kept]
+
+
+def _where_the_stops_allow(d: Derivation, results, verdicts, values, warnings):
+    """Leave out equilibria where a declared stop that needs Newton's method says the model
+    does not hold (the ladder hanging through the floor at θ = π, where the wall would have to
+    pull): the same test /simulate applies to its initial state, so a "start near" there is a
+    422 and the panel says so first. Stops given by `when` are judged by `_inside_the_model`."""
+    m = d.model
+    if not any(st.when is None for st in m.stops[: len(m.spec.stops)]) or not results:
+        return results, verdicts
+    from mechanics.numeric import compile_derivation
+    from mechanics.stops import refuse_passed_stops
+
+    try:
+        c = _once(d, "compiled", "", lambda: compile_derivation(d))
+        named = {str(p): float(x) for p, x in values.items()}
+        params = [named[k] for k in c.parameters]
+    except (SpecError, KeyError):  # a stop /simulate refuses as a field error: nothing to judge
+        return results, verdicts
+    kept, out = [], []
+    for r, v in zip(results, verdicts, strict=True):
+        y0 = np.array([*(r["q"][q] for q in c.coordinates), *[0.0] * (c.n + c.extras)])
+        try:
+            refuse_passed_stops(c, params, y0)
+        except SpecError as exc:
+            held = [e["message"] for e in exc.errors if "does not hold" in e["message"]]
+            if held:
+                out.append((r, held[0]))
+                continue
+        kept.append((r, v))
+    for r, why in out:
+        warnings.append(
+            f"The forces balance at {', '.join(f'{k} = {x:.4g}' for k, x in r['q'].items())}, "
+            f"but {why}: a run cannot start there, so it is left out."
+        )
+    return [r for r, _ in kept], [v for _, v in kept]
 
 
 _NOT_SMOOTH = (
@@ -1922,9 +1990,189 @@ def _stability(
     vectors = [vecs[: len(idx), i] for i in range(len(lam))]
     verdict = Verdict(kind, reason, list(lam), freqs, modes, phases, linear, vectors)
     lost = [j for j in range(n) if j not in idx]
+    if lost and at_rest is not None and _turns_beside(at_rest, full_M, q0, numbers, idx, lost):
+        # Coriolis (or a magnetic force) couples the radial motion to the turn about the pole
+        # with a weight ∝ r that vanishes at it: only coordinates regular there see it
+        return _pole_in_cartesian(v, at_rest, full_M, q0, numbers, psyms, idx, lost, free, power)
     if lost:
         _at_a_pole(verdict, m, full_M, at_rest, q0, numbers if at_rest else [], idx, lost, free)
     return verdict
+
+
+def _turns_beside(at_rest, full_M, q0, numbers, idx, lost) -> bool:
+    """Do velocity-linear forces act just off the pole (Coriolis 2mΩ r ṙ φ̇ on a turntable)?
+    Their share in the coordinates kept vanishes at it (∝ r), so the linearization in those
+    alone loses them, and with them the split of the two modes about the pole."""
+    for i in _radial(None, full_M, at_rest, q0, numbers, idx, lost):
+        point = list(q0)
+        point[i] += 1e-2
+        with np.errstate(all="ignore"):
+            try:
+                M_h, _, C_h = (np.array(x, dtype=float) for x in at_rest(*point, *numbers))
+            except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+                return True  # nothing to judge by: the Cartesian test below decides or refuses
+        scale = max(float(np.max(np.abs(M_h))), 1e-300)
+        if not np.all(np.isfinite(C_h)) or np.max(np.abs(C_h)) > 1e-12 * scale:
+            return True
+    return False
+
+
+#: The local Cartesian coordinates about a pole, ξ = ρ cos φ and η = ρ sin φ.
+_XI, _ETA = sp.Symbol("xi"), sp.Symbol("eta")
+
+
+def _pole_in_cartesian(v, at_rest, full_M, q0, numbers, psyms, idx, lost, free, power) -> Verdict:
+    """The verdict at a pole where velocity-linear forces act, from the full linearization in
+    coordinates regular there: ρ (the radial coordinate less its pole value) and the lost
+    angle φ become ξ = ρ cos φ, η = ρ sin φ, as a Cartesian description would have them.
+
+    Lagrange's equations transform with the Jacobian J = ∂q/∂p: M_p = Jᵀ M J, C_p = Jᵀ C J at
+    rest (the J̇ ṗ term is quadratic in ṗ) and K_p = −∂(Jᵀ f)/∂p. J is singular at the pole,
+    but these are smooth in p there; they are evaluated on a ring of points about it and
+    extrapolated (Richardson), and two step sizes must agree. Where the chart does not fit (not
+    one radial coordinate and one lost angle) or the estimates disagree, the verdict is
+    refused as undecided, never guessed: the turntable's origin at k = 1, Ω = 1.5 had been
+    'unstable' (the radial row alone, each motion counted twice) where ω = |√(k/m) ± Ω|."""
+    m = v.model
+    n = len(q0)
+    radial = _radial(None, full_M, at_rest, q0, numbers, idx, lost)
+    names = [m.coordinate_names[j] for j in range(n)]
+    pole_at = "$" + ", ".join(f"{to_latex(m.q[j])} = {_num(q0[j])}" for j in idx) + "$"
+    lost_names = ", ".join(f"${to_latex(m.q[j])}$" for j in lost)
+    linear = None
+    if len(lost) == 1 and len(radial) == 1:
+        linear = _cartesian_linearization(v, at_rest, q0, numbers, psyms, radial[0], lost[0])
+    if linear is None:
+        return Verdict(
+            "marginal",
+            f"{pole_at} is a pole of the coordinates (any {lost_names} names the same point), "
+            "and velocity-linear forces (Coriolis where a frame turns) couple the motion off "
+            "it to the turn about it with a weight that vanishes there: these coordinates are "
+            "singular at it and cannot linearize the full motion, so the linear test cannot "
+            "decide; a Cartesian description of the scene decides it",
+            [],
+            [],
+            [],
+            [],
+            None,
+            pole=True,
+        )
+    M, C, K, order = linear
+    a, b = radial[0], lost[0]
+    # ξ and η are free only where both ρ and φ are (k = mΩ² on the turntable: no force at all)
+    n_free = len([j for j in free if j not in (a, b)]) + (2 if a in free and b in free else 0)
+    local = [_XI if j == a else _ETA if j == b else m.q[j] for j in order]
+    shown = ["xi" if j == a else "eta" if j == b else names[j] for j in order]
+    kind, reason, lam, vecs = _classify(M, C, K, n_free, shown, turning=_turning(m), power=power)
+    freqs: list[float] = []
+    if kind != "unstable":
+        freqs, _, _ = _modes(M, C, K, lam, vecs, list(range(len(order))), len(order))
+    rho = to_latex(m.q[a]) if abs(q0[a]) <= 1e-12 else f"({to_latex(m.q[a])} - {_num(q0[a])})"
+    phi = to_latex(m.q[b])
+    reason += (
+        f"; {pole_at} is a pole of the coordinates (any {lost_names} names the same point), so "
+        f"the motion is linearized in the local Cartesian coordinates $\\xi = {rho}\\cos {phi}$, "
+        f"$\\eta = {rho}\\sin {phi}$, which are regular there and keep the velocity-linear "
+        "(Coriolis) coupling of the two directions; the modes are whirls in $\\xi, \\eta$, not "
+        "motions of the scene's coordinates, so none is offered to excite"
+    )
+    verdict = Verdict(kind, reason, list(lam), freqs, [], [], None, pole=True)
+    verdict.linear = {"M": M, "C": C, "K": K, "coordinates": local}
+    return verdict
+
+
+def _cartesian_linearization(v, at_rest, q0, numbers, psyms, a, b):
+    """M, C, K at the pole in p = q with (q_a, q_b) → (ξ, η), and the coordinate order of p
+    (a's place holds ξ, b's η); None when two step sizes disagree (the chart is not smooth
+    there, or the scale of the coordinates is far from the steps)."""
+    m = v.model
+    n = len(q0)
+    psyms_n = numbers
+    forces = _rest_force_function(tuple(v.forcing), tuple(m.q), tuple(m.qd), tuple(m.qdd), psyms)
+
+    def chart(p: np.ndarray) -> tuple[list[float], np.ndarray]:
+        x, y = p[a], p[b]
+        rho = math.hypot(x, y)
+        q = list(p)
+        q[a] = q0[a] + rho
+        q[b] = q0[b] + math.atan2(y, x)
+        J = np.eye(n)
+        J[a, a], J[a, b] = x / rho, y / rho
+        J[b, a], J[b, b] = -y / rho**2, x / rho**2
+        return q, J
+
+    def inertia_and_velocity(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        q, J = chart(p)
+        M_q, _, C_q = (np.array(e, dtype=float).reshape(n, n) for e in at_rest(*q, *psyms_n))
+        return J.T @ M_q @ J, J.T @ C_q @ J
+
+    def generalized(p: np.ndarray) -> np.ndarray:
+        q, J = chart(p)
+        f = np.array(forces(*q, *psyms_n), dtype=float).reshape(n)
+        return J.T @ f
+
+    p0 = np.array(q0, dtype=float)
+    p0[a] = p0[b] = 0.0
+
+    def estimate(h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        ring = []
+        for c, s in ((1, 0), (0, 1), (-1, 0), (0, -1)):
+            o = np.zeros(n)
+            o[a], o[b] = c * h, s * h
+            ring.append(o)
+        pairs = [inertia_and_velocity(p0 + o) for o in ring]
+        M = sum(x for x, _ in pairs) / 4
+        C = sum(x for _, x in pairs) / 4
+        # smooth through the pole: each side's M_p within O(h²) of the mean. Euler angles at
+        # θ = 0 are not (the turn φ + ψ about the axis jumps with the direction of approach)
+        size = max(float(np.max(np.abs(M))), 1e-300)
+        if any(np.max(np.abs(x - M)) > 1e-2 * size for x, _ in pairs):
+            raise ValueError("not smooth at the pole")
+        K = np.zeros((n, n))
+        for k in range(n):
+            e = np.zeros(n)
+            e[k] = h
+            centres = [np.zeros(n)] if k in (a, b) else ring
+            K[:, k] = -sum(
+                (generalized(p0 + o + e) - generalized(p0 + o - e)) / (2 * h) for o in centres
+            ) / len(centres)
+        return M, C, K
+
+    with np.errstate(all="ignore"):
+        try:
+            rough = [estimate(h) for h in (2e-3, 1e-3)]
+            fine = [estimate(h) for h in (1e-3 / 2, 1e-3 / 4)]
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError):
+            return None
+    first = [(4 * f - c) / 3 for c, f in zip(*rough, strict=True)]
+    second = [(4 * f - c) / 3 for c, f in zip(*fine, strict=True)]
+    if not all(np.all(np.isfinite(x)) for x in (*first, *second)):
+        return None
+    M, C, K = second
+    # a common scale: the size of every term in the equations, per unit displacement/velocity
+    size = max(float(np.max(np.abs(M))), 1e-300)
+    rate = math.sqrt(max(float(np.max(np.abs(K))), float(np.max(np.abs(C))) ** 2 / size) / size)
+    scales = (size, size * rate, size * rate**2)
+    for x, y, s in zip(first, second, scales, strict=True):
+        if np.max(np.abs(x - y)) > 1e-6 * max(s, 1e-300):
+            return None
+    M, C, K = (
+        np.where(np.abs(x) <= 1e-9 * max(s, 1e-300), 0.0, x)
+        for x, s in zip(second, scales, strict=True)
+    )
+    M = (M + M.T) / 2
+    return M, C, K, list(range(n))
+
+
+@functools.lru_cache(maxsize=64)
+def _rest_force_function(forcing: tuple, qs: tuple, qds: tuple, qdds: tuple, psyms: tuple):
+    """f at rest (q̇ = q̈ = 0, t = 0) as a numpy function of (q, parameters): the generalized
+    forces the pole's Cartesian linearization differentiates."""
+    rest = {**dict.fromkeys(qdds, 0), **dict.fromkeys(qds, 0)}
+    xs = [sp.Dummy(f"q{j}") for j in range(len(qs))]
+    to_x = dict(zip(qs, xs, strict=True))
+    f = [(sp.S.Zero + e).xreplace(rest).xreplace(to_x).xreplace({t: sp.S.Zero}) for e in forcing]
+    return sp.lambdify([*xs, *psyms], f, modules="numpy", dummify=True)
 
 
 def _held_at_pole(d: Derivation, v: Variant, q0: list[float], values: dict) -> bool:
