@@ -36,7 +36,10 @@ def probe_states(model: Model, count: int = PROBES) -> list[dict[sp.Symbol, sp.E
         }
         values[model.names["t"]] = sp.Rational(rng.randint(200, 2000), 1000)
         for name, q, qd in zip(model.coordinate_names, model.q, model.qd, strict=True):
-            start = float(initial.get(name, 0.0) or 0.0)
+            try:
+                start = float(initial.get(name, 0.0) or 0.0)
+            except (TypeError, ValueError):  # an expression: any start will do
+                start = 0.0
             if q.is_positive:
                 value = (start if start > 0 else 0.5) * rng.uniform(0.7, 1.3)
             else:
