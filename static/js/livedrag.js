@@ -85,7 +85,7 @@ export class BodyDrag {
     const body = this.#pick(at);
     if (!body) return null;
     const { live, initial, params } = this.sv;
-    return movers(live, body, live.state(initial), live.paramVector(params)).length ? body : null;
+    return movers(live, body, this.#drawnState(live.state(initial)), live.paramVector(params)).length ? body : null;
   }
 
   #hover(e) {
@@ -100,16 +100,30 @@ export class BodyDrag {
     this.canvas.style.cursor = body ? "grab" : "";
   }
 
-  /** The state the run on the canvas passes through at its drawn frame (q, and q̇ = 0). */
-  #drawnState(fallback) {
+  /** The state the run on the canvas passes through at its drawn frame: its q, and q̇ = 0 (a
+   * position drag drops the body from rest) or, with `rates`, the run's own q̇ there (a velocity
+   * drag then changes only the rates that move the body taken; the others go on as they were). */
+  #drawnState(fallback, { rates = false } = {}) {
     const { shown, live, stageA } = this.sv;
     const y = Float64Array.from(fallback);
     live.meta.coordinates.forEach((q, j) => {
       const v = shown.q?.[q]?.[stageA.frame];
       if (Number.isFinite(v)) y[j] = v;
-      y[live.n + j] = 0;
+      const w = shown.q_dot?.[q]?.[stageA.frame];
+      y[live.n + j] = rates && Number.isFinite(w) ? w : 0;
     });
     return y;
+  }
+
+  /** State y with `body` moved to where it is drawn (`seen`, on the screen): the new start is at
+   * t = 0, and where a constraint moves with time (a spinning hoop) the same q put it elsewhere
+   * then; elsewhere it is there already and nothing changes. */
+  #placedAsSeen(body, seen, y, p, positive) {
+    const { live, stageA } = this.sv;
+    const view = stageA.view;
+    if (view.is3D) return placeOnScreen(live, body, view, seen, seen[2], y, p, { positive });
+    const here = live.places(y, p)[body];
+    return live.reach(body, unproject(view, seen[0], seen[1], here[2]), y, p);
   }
 
   #down(e) {
@@ -125,16 +139,17 @@ export class BodyDrag {
     this.canvas.setPointerCapture?.(e.pointerId);
     this.canvas.style.cursor = "grabbing";
     const velocity = this.velocityMode || e.shiftKey;
-    const start = live.state(sv.initial);
-    // A position drag starts from the pose on the screen (the body is taken where it is seen,
-    // which keeps a double pendulum's elbow or a bob's side of its sphere); a velocity drag
-    // gives the starting pose a velocity.
-    const y = velocity ? start : this.#drawnState(start);
-    this.drag = {
-      body, velocity, at, press: at, view: st.view, y, p: live.paramVector(sv.params), moved: false,
-      seen: st.view.project(st.geom.at(body, st.frame)), // where the body was taken
-      positive: (sv.spec.positive_coordinates || []).map((q) => live.meta.coordinates.indexOf(q)).filter((j) => j >= 0),
-    };
+    // Both kinds of drag start from the instant on the screen, the body taken where it is seen
+    // (which keeps a double pendulum's elbow or a bob's side of its sphere): a position drag
+    // moves it from there, a velocity drag gives it a velocity there. (A velocity drag once
+    // started from the scene's start: the body jumped away from under the pointer, and out of
+    // a following camera's view.)
+    const p = live.paramVector(sv.params);
+    const seen = st.view.project(st.geom.at(body, st.frame)); // where the body was taken
+    const positive = (sv.spec.positive_coordinates || []).map((q) => live.meta.coordinates.indexOf(q)).filter((j) => j >= 0);
+    const drawn = this.#drawnState(live.state(sv.initial), { rates: velocity });
+    const y = velocity ? this.#placedAsSeen(body, seen, drawn, p, positive) : drawn;
+    this.drag = { body, velocity, at, press: at, view: st.view, y, p, moved: false, seen, positive };
     const move = (m) => {
       this.drag.at = this.#local(m);
       this.drag.moved = true;
