@@ -138,6 +138,7 @@ export class SceneGeometry {
     };
     if ([...this.wires, ...this.hoops].some((w) => spinsInPlane(w.frame))) this.is3D = true;
     this.supports = this.#supports();
+    this.slides = this.#slides(); // {body, origin, dir, lo, hi, away}: a line a rod's end slides on
   }
 
   at(name, i) {
@@ -391,6 +392,34 @@ export class SceneGeometry {
     return true;
   }
 
+  /** The straight lines the ends of a turning, unpinned rod slide along (a ladder's wall and
+   * floor), read from the measured samples; `away` points from the line to the rod's side. */
+  #slides() {
+    const out = [], linked = new Set(this.links.map(([, b]) => b));
+    for (const [name, shape] of this.shapes) {
+      const body = this.bodies.find((b) => b.name === name);
+      const run = this.result.sampled?.frames?.[body.frame] ? this.result.sampled : this.result;
+      const F = run.frames[body.frame], G = run.positions[name];
+      if (shape.kind !== "rod" || linked.has(name) || !G || run.t.length < 3) continue;
+      const axis = (i) => F[i].slice(3 * shape.axis, 3 * shape.axis + 3);
+      if (!F.some((_, i) => norm(cross(axis(i), axis(0))) > 0.05)) continue; // it must turn
+      for (const sign of [-1, 1]) {
+        const ends = run.t.map((_, i) => add([G.x[i], G.y[i], G.z[i]], mul(axis(i), sign * shape.half)));
+        const reach = Math.max(...ends.map((p) => norm(sub(p, ends[0]))));
+        if (reach < 1e-3 * shape.half) continue;
+        const dir = unit(sub(ends.find((p) => norm(sub(p, ends[0])) === reach), ends[0]));
+        const s = ends.map((p) => dot(sub(p, ends[0]), dir));
+        if (ends.some((p, i) => norm(sub(sub(p, ends[0]), mul(dir, s[i]))) > 1e-4 * reach)) continue;
+        const g = sub([G.x[0], G.y[0], G.z[0]], ends[0]), across = sub(g, mul(dir, dot(g, dir)));
+        if (norm(across) < 1e-9) continue;
+        const margin = shape.half / 2;
+        out.push({ body: name, origin: ends[0], dir, lo: Math.min(...s) - margin, hi: Math.max(...s) + margin,
+          away: unit(across) });
+      }
+    }
+    return out;
+  }
+
   /** A rigid body's outline (rigid.js) in the world at sample i: through G, in its frame. */
   outlineAt(name, i) {
     const shape = this.shapes.get(name), body = this.bodies.find((b) => b.name === name);
@@ -635,6 +664,7 @@ export class SceneGeometry {
       around(add(apex, rim), r);
     }
     for (const r of this.rolls) pts.push(...r.contacts);
+    for (const w of this.slides) pts.push(add(w.origin, mul(w.dir, w.lo)), add(w.origin, mul(w.dir, w.hi)));
     const linked = new Set(this.links.map(([, b]) => b));
     for (const name of this.shapes.keys()) {
       if (!linked.has(name)) for (const i of idx) pts.push(...this.outlineAt(name, i));

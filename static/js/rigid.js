@@ -125,3 +125,15 @@ export function rollingSurfaceShapes(pts, outward) {
   }
   return out;
 }
+
+/** A line a rod's end slides on, from screen point a to b, hatched on the side away from the rod
+ * (`toRod`: the screen unit vector toward it). */
+export function slideLineShapes(a, b, toRod) {
+  const out = [{ t: "line", a, b, color: "#868e96", width: 2, piece: "slide-line" }];
+  const len = Math.hypot(b[0] - a[0], b[1] - a[1]) || 1, d = [(b[0] - a[0]) / len, (b[1] - a[1]) / len];
+  for (let s = 5; s < len; s += 10) {
+    const x = a[0] + d[0] * s, y = a[1] + d[1] * s;
+    out.push({ t: "line", a: [x, y], b: [x - toRod[0] * 7 - d[0] * 5, y - toRod[1] * 7 - d[1] * 5], color: "#adb5bd", width: 1 });
+  }
+  return out;
+}

@@ -2,7 +2,7 @@
 // render.js draws on a canvas or writes as SVG: the animation, the catalog drawings and the
 // free-body diagram all come from here.
 import { add, dot, mul, sub } from "./geometry.js";
-import { rigidBodyShapes, rollingSurfaceShapes } from "./rigid.js";
+import { rigidBodyShapes, rollingSurfaceShapes, slideLineShapes } from "./rigid.js";
 
 const INK = "#343a40";
 const GROUND = "#868e96";
@@ -25,6 +25,10 @@ export function sceneShapes(geom, view, i, opts = {}) {
   for (const r of geom.rolls) {
     const pts = r.contacts.map((p) => view.project(p).slice(0, 2));
     out.push(...rollingSurfaceShapes(pts, r.contacts.map((p, k) => view.direction(p, r.outward[k]))));
+  }
+  for (const w of geom.slides) {
+    const a = view.project(add(w.origin, mul(w.dir, w.lo))).slice(0, 2), b = view.project(add(w.origin, mul(w.dir, w.hi))).slice(0, 2);
+    out.push(...slideLineShapes(a, b, view.direction(w.origin, w.away)));
   }
   for (const sf of geom.surfaces) {
     for (const line of sf.lines) {

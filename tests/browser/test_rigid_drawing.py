@@ -1,8 +1,9 @@
 """Rigid bodies drawn as what they are (physics play-test 4, finding 3): a body whose centre keeps
 its distance from O hangs on a rod from O only when O is a point of the body. A cylinder rolling
 inside a cylinder is a disk of its own radius inside the surface it rolls on; a ladder sliding
-down a frictionless wall is a rod from the wall to the floor, pivoted nowhere. Where things must
-be is worked out here from the specs' geometry, and checked on the canvas's pixels."""
+down a frictionless wall is a rod from the wall to the floor (both drawn), pivoted nowhere.
+Where things must be is worked out here from the specs' geometry, and checked on the canvas's
+pixels."""
 
 from __future__ import annotations
 
@@ -157,6 +158,12 @@ def test_a_ladder_is_a_rod_from_the_wall_to_the_floor_pivoted_nowhere(server, pa
     g = (L / 2 * math.sin(PHI0), L / 2 * math.cos(PHI0))
     old = [project(cam, (f * g[0], f * g[1], 0.0)) for f in (0.0, 0.3, 1.7)]
     assert p.evaluate(BLUE_NEAR, [past + old, 1]) == [False] * 5
+    # the wall (x = 0) and the floor (y = 0) its ends slide on, grey; not off to the side
+    assert "slide-line" in pieces, pieces
+    lines = [(0.0, 1.2, 0.0), (0.0, 2.2, 0.0), (0.3, 0.0, 0.0), (1.1, 0.0, 0.0)]
+    off = [(-0.3, 1.2, 0.0), (0.3, 1.2, 0.0), (1.1, 0.3, 0.0), (1.1, -0.3, 0.0)]
+    assert p.evaluate(GREY_NEAR, [[project(cam, q) for q in lines]]) == [True] * 4
+    assert p.evaluate(GREY_NEAR, [[project(cam, q) for q in off]]) == [False] * 4
     # its equilibrium sketch (upright at the wall) draws the rod and no support
     p.wait_for_function("document.querySelectorAll('#equilibria svg[data-ready]').length > 0")
     drawn = p.eval_on_selector_all(
