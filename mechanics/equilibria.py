@@ -2073,8 +2073,9 @@ def _pole_in_cartesian(v, at_rest, full_M, q0, numbers, psyms, idx, lost, free, 
         f"; {pole_at} is a pole of the coordinates (any {lost_names} names the same point), so "
         f"the motion is linearized in the local Cartesian coordinates $\\xi = {rho}\\cos {phi}$, "
         f"$\\eta = {rho}\\sin {phi}$, which are regular there and keep the velocity-linear "
-        "(Coriolis) coupling of the two directions; the modes are whirls in $\\xi, \\eta$, not "
-        "motions of the scene's coordinates, so none is offered to excite"
+        "terms (Coriolis where a frame turns, damping) that vanish at the pole in the scene's "
+        "coordinates; the modes are motions of $\\xi, \\eta$, not of the scene's coordinates, so "
+        "none is offered to excite"
     )
     verdict = Verdict(kind, reason, list(lam), freqs, [], [], None, pole=True)
     verdict.linear = {"M": M, "C": C, "K": K, "coordinates": local}
