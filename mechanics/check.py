@@ -79,6 +79,30 @@ def _never_zero(factor: sp.Expr) -> bool:
     return factor != 0
 
 
+def _sign_definite(factor: sp.Expr, model: Any) -> bool:
+    """Is ``factor`` provably non-zero and finite at every state the scene reaches (2 + sin²θ₁;
+    1/(m r) with r declared positive)? Then multiplying an equation of motion by it loses and
+    adds no solution. Decided by sympy's sign rules, factor by factor, under the scene's own
+    assumptions: coordinates declared positive are positive, and parameters that are magnitudes
+    (a mass, a length) are taken positive, as `_never_zero` takes them for a constant factor
+    (at 0 the derived equation itself degenerates). Anything sympy cannot settle is not
+    definite: the caller keeps the cautious verdict."""
+    if factor.has(*model.qdd) or sp.count_ops(factor) > SIMPLIFY_OPS:
+        return False
+    to_sym, _ = _symbols_for(model)
+    plain = factor.xreplace(to_sym)
+    plain = plain.xreplace(
+        {s: sp.Symbol(s.name, positive=True) for s in plain.free_symbols if s.is_nonnegative}
+    )
+    # one form may show it where another does not ((2 + sin²θ₁)(sin²θ₂ + cos²θ₂) once cos² is
+    # read as 1 − sin²): each is the same expression, so any one proof is sound
+    forms = (plain, sp.trigsimp(plain), _tidy(plain, model))
+    return any(
+        all(part.is_positive or part.is_negative for part in sp.Mul.make_args(sp.factor(form)))
+        for form in forms
+    )
+
+
 #: How a verdict that no proof could settle begins (`Verdict.confirmed`).
 UNCONFIRMED = "Not confirmed"
 
@@ -1127,6 +1151,15 @@ class _Judge:
                 "equation (the same equation, rearranged or scaled)."
             )
             return
+        factor = self._nonvanishing_multiple(given, expected) if ratio in (None, 0) else None
+        if factor is not None:
+            verdict.correct = True
+            fb.append(
+                f"Correct: the derived equation multiplied by {inline(factor)}, which changes "
+                "with the state but is never zero (nor infinite) where the scene moves, so it "
+                "has the same solutions."
+            )
+            return
         if ratio in (None, 0):  # else the samples saw a multiple, and a proof refuted it
             self._how_it_holds(given, expected, fb)
             if fb:
@@ -1134,12 +1167,21 @@ class _Judge:
         if self._inertia_only(given, expected, fb):
             return
         scale = self._scaling(given, expected)
-        if scale is not None and scale != 1 and _never_zero(scale):
+        if scale is None:  # r φ̈ for m r² φ̈: no term in common, the q̈ terms still say the factor
+            scale = self._lead_ratio(given, expected)
+        constant = scale is not None and scale != 1 and _never_zero(scale)
+        state = scale is not None and scale.has(t) and _sign_definite(scale, self.m)
+        if constant or state:
             # compare with the derived equation as the student scaled it, so the feedback names
-            # their own terms (g/l sin θ), not the derived equation's (m g l sin θ)
+            # their own terms (g/l sin θ), not the derived equation's (m g l sin θ); a factor of
+            # the state that never vanishes (1/(m r), r > 0) changes nothing either
+            why = (
+                "scaling an equation changes nothing"
+                if constant
+                else "a factor that is never zero where the scene moves changes nothing"
+            )
             fb.append(
-                f"Read as the derived equation multiplied by {inline(scale)} (scaling an equation "
-                "changes nothing); against that:"
+                f"Read as the derived equation multiplied by {inline(scale)} ({why}); against that:"
             )
             expected = expected * scale
             self.scale = scale
@@ -1186,11 +1228,16 @@ class _Judge:
                 return
         solved = dict(zip(self.m.qdd, self.d.solved_accelerations, strict=True))
         if self.same(given.xreplace(solved), sp.S.Zero) and self._multiple_of_own(given, expected):
+            qdd = self.m.qdd[self.j]
+            factor = partial(given, qdd, self.m) / partial(expected, qdd, self.m)
+            short = sp.count_ops(factor) <= SIMPLIFY_OPS  # named only while it reads at a glance
+            by = inline(sp.factor(factor)) if short else "a factor"
             fb.append(
                 "Your equation holds along the motion, but it is the derived equation for "
-                f"{inline(self.m.q[self.j])} multiplied by something that changes with the state, "
-                "not by a constant: where that factor is zero your equation says nothing. Scale "
-                "an equation of motion only by a non-zero constant."
+                f"{inline(self.m.q[self.j])} multiplied by {by}, which changes with the state "
+                "and may be zero at some states: where it is, your equation says nothing. Scale "
+                "an equation of motion only by a non-zero constant, or by a factor that is never "
+                "zero."
             )
             return
         if self.same(given.xreplace(solved), sp.S.Zero):
@@ -1370,6 +1417,28 @@ class _Judge:
         if same is not True:
             return same
         return constant_proof(cg / ce, self.m)
+
+    def _nonvanishing_multiple(self, given: sp.Expr, expected: sp.Expr) -> sp.Expr | None:
+        """The factor F when ``given`` is proved F times the derived equation, F a function of
+        the state that is provably never zero or infinite there (r φ̈ + 2 ṙ φ̇ is the cone's
+        m r² φ̈ + 2 m r ṙ φ̇ over m r, r > 0): the same equation, divided through. None when
+        either cannot be proved: a factor that may vanish hides the equation where it does."""
+        factor = self._lead_ratio(given, expected)
+        if factor is None or zero_proof(given - factor * expected, self.m) is not True:
+            return None
+        return factor
+
+    def _lead_ratio(self, given: sp.Expr, expected: sp.Expr) -> sp.Expr | None:
+        """The ratio of the q̈_j coefficients when it is a factor of the state (not a constant:
+        those are `_never_zero`'s) that never vanishes (1/(m r) with r > 0), else None."""
+        qdd = self.m.qdd[self.j]
+        ce, cg = partial(expected, qdd, self.m), partial(given, qdd, self.m)
+        if ce == 0 or cg == 0:
+            return None
+        if sp.count_ops(cg / ce) > SIMPLIFY_OPS:
+            return None  # a factor this long is nothing a student divides an equation by
+        factor = sp.factor(_tidy(cg / ce, self.m))
+        return factor if factor.has(t) and _sign_definite(factor, self.m) else None
 
     def _scaling(self, given: sp.Expr, expected: sp.Expr) -> sp.Expr | None:
         """The factor the student's equation carries over the derived one, read from the terms
