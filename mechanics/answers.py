@@ -11,13 +11,14 @@ equation's two sides, and every error's position carried back to the character t
 
 from __future__ import annotations
 
+import difflib
 import re
 from collections.abc import Iterable
 
 import sympy as sp
 
 from mechanics.derive import Derivation
-from mechanics.expr import FUNCTIONS, MAX_LENGTH, ExprError, parse
+from mechanics.expr import FUNCTIONS, MAX_EXP_NESTING, MAX_LENGTH, ExprError, parse
 from mechanics.model import T
 
 GREEK = {
@@ -142,6 +143,9 @@ def to_convention_mapped(
             # cos θ' is cos(θ'): the prime belongs to the argument just wrapped
             k = bare[1] if bare and out[-1][1] == ")" else len(out) - 1
             if not out or out[k][0] != "name" or out[k][1] not in coordinates:
+                if out and out[k][0] == "name":  # a rate of something: name what it is instead
+                    message = _not_a_coordinate(out[k][1], coordinates, known)
+                    raise ExprError(message, field=field, position=out[k][2])
                 raise ExprError(
                     "a prime or dot must follow a coordinate name",
                     field=field,
@@ -183,8 +187,10 @@ def to_convention_mapped(
             elif kind not in ("num", "name"):
                 raise power_refused(at)
         if kind == "name" and _is_time_derivative(out, value, typed, known):
-            if text[m.end() :].lstrip()[:1] != "(":
-                raise ExprError(_DDT_PARENTHESES, field=field, position=origin[m.start()])
+            rest = text[m.end() :]
+            if rest.lstrip()[:1] != "(":  # point where the '(' goes: before what d/dt is of
+                where_open = m.end() + len(rest) - len(rest.lstrip())
+                raise ExprError(_DDT_PARENTHESES, field=field, position=origin[where_open])
             out.pop()
             at = out.pop()[2]
             _append(out, "name", DDT, at)
@@ -240,6 +246,23 @@ def to_convention_mapped(
         where += [at] * len(value)
     where.append(len(typed))
     return "".join(result), where
+
+
+def _not_a_coordinate(name: str, coordinates: set[str], known: set[str]) -> str:
+    """Why `name'` is refused, about the name the student typed: a misspelt coordinate gets
+    the parser's did-you-mean (`thetta1'` -> theta1), a name of another scene (`theta'` where
+    the only coordinate is x) the coordinates this scene has, a parameter that it is one."""
+    listed = ", ".join(sorted(coordinates))
+    if name in known or name in FUNCTIONS or name == "pi":
+        what = "the time" if name == "t" else "not a coordinate"
+        return (
+            f"a prime or dot must follow a coordinate name: '{name}' is {what}; the "
+            f"coordinates of this scene are {listed}"
+        )
+    close = difflib.get_close_matches(name, sorted(coordinates), n=1)
+    if close:
+        return f"unknown name '{name}'; did you mean '{close[0]}'?"
+    return f"'{name}' is not a coordinate of this scene; its coordinates are {listed}"
 
 
 def _function_power(function: str, argument: str) -> str:
@@ -401,7 +424,22 @@ def read_answer(
         except ExprError as exc:
             at = None if exc.position is None else where[min(start + exc.position, len(text))]
             message = exc.message
-            if exc.position is not None and "'**'" in message:
+            located = exc.position is not None
+            nest = _exponential_nest(text, start + exc.position) if located else None
+            if (
+                nest is not None
+                and nest[1] > MAX_EXP_NESTING  # else powers with variable exponents count too
+                and message.startswith("exponentials nested more than")
+            ):
+                # the parser stops at the first sub-expression past the limit (exp(exp(exp(…
+                # inside exp(…)): point at the whole nest the student typed, and count it
+                at, depth = where[nest[0]], nest[1]
+                message = (
+                    f"{depth} exponentials (exp, sinh, cosh) nested one inside another from "
+                    f"here; at most {MAX_EXP_NESTING} may nest: exp(exp(exp(x))) is already "
+                    "past what a double can hold at x = 3"
+                )
+            elif exc.position is not None and "'**'" in message:
                 # the parser saw '**' where the student typed '^': name what was typed
                 k = start + exc.position
                 ops = [i for i in (k, k - 2) if 0 <= i and text[i : i + 2] == "**"]
@@ -418,11 +456,17 @@ def read_answer(
         raise _pointed(
             "write one '=' between the two sides, not '=='", answer, where[double.start()]
         )
-    if quantity not in ("eom", "accel") or text.count("=") > 1:
+    if quantity not in ("eom", "accel"):
         raise _pointed(
-            "'=' belongs only in an equation of motion or q̈ = ... (once)",
+            "'=' belongs only in an equation of motion or q̈ = ...: this answer is one expression",
             answer,
-            where[text.rindex("=") if text.count("=") > 1 else equals],
+            where[equals],
+        )
+    if text.count("=") > 1:  # point at the second '=', the first one too many
+        raise _pointed(
+            f"an equation has one '=' between its two sides; this has {text.count('=')}",
+            answer,
+            where[text.index("=", equals + 1)],
         )
     lhs, rhs = read(0, equals), read(equals + 1, len(text))
     if quantity == "eom":
@@ -432,6 +476,38 @@ def read_answer(
         return (rhs if lhs == qdd else lhs), sp.S.Zero
     name = model.coordinate_names[j]
     raise _pointed(f"write q̈ as '{name}_ddot = ...'", answer, where[equals])
+
+
+_EXPONENTIALS = ("exp", "sinh", "cosh")  # the functions the parser's nesting limit counts
+
+
+def _exponential_nest(text: str, k: int) -> tuple[int, int] | None:
+    """The outermost exponential call (exp, sinh, cosh) of the rewritten ``text`` whose span
+    holds position ``k``, and how many exponential calls nest in it at most: (where its name
+    starts, that depth). None when no exponential call holds ``k``."""
+    stack: list[int | None] = []  # each open '(': where its exponential's name starts, or None
+    depths: dict[int, int] = {}  # outermost exponential's start -> deepest nesting under it
+    spans: dict[int, int] = {}  # outermost exponential's start -> where its ')' is
+    previous = None
+    for m in _TOKEN.finditer(text):
+        kind, value = m.lastgroup, m.group()
+        if kind == "space":
+            continue
+        if value == "(":
+            exponential = previous is not None and previous.group() in _EXPONENTIALS
+            stack.append(previous.start() if exponential else None)
+            starts = [at for at in stack if at is not None]
+            if starts:
+                depths[starts[0]] = max(depths.get(starts[0], 0), len(starts))
+        elif value == ")" and stack:
+            at = stack.pop()
+            if at is not None and all(x is None for x in stack):
+                spans[at] = m.start()
+        previous = m if kind == "name" else None
+    for start, end in spans.items():
+        if start <= k <= end:
+            return start, depths[start]
+    return None
 
 
 def _time_derivatives(
