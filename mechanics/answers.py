@@ -435,8 +435,8 @@ def read_answer(
                 # inside exp(…)): point at the whole nest the student typed, and count it
                 at, depth = where[nest[0]], nest[1]
                 message = (
-                    f"{depth} exponentials (exp, sinh, cosh) nested one inside another from "
-                    f"here; at most {MAX_EXP_NESTING} may nest: exp(exp(exp(x))) is already "
+                    f"{depth} exponentials nested one inside another from here (exp, sinh, "
+                    f"cosh); at most {MAX_EXP_NESTING} may nest: exp(exp(exp(x))) is already "
                     "past what a double can hold at x = 3"
                 )
             elif exc.position is not None and "'**'" in message:
