@@ -4,8 +4,8 @@
 // through first: the same keys scroll it a screen at a time before the next step is revealed, and
 // the counter says when more of it lies below; ← pages back up through it, then hides it and
 // shows the step before from its title (just under the sticky header). The counter sits in the sticky header in lecture
-// mode, so the room always sees where it is; the page's address keeps the step (?step=, from 0),
-// and a link with one opens scrolled to that step.
+// mode, so the room always sees where it is; the page's address keeps the step as the header counts
+// it (?step=5 is "step 5 of N", linkedStep), and a link with one opens scrolled to that step.
 // The derivation stands beside the animation, so in lecture mode it is moved next to it in the
 // page too: the tab order and a screen reader follow what the room sees. Its equations are fitted
 // to the narrower column (fit.js).
@@ -124,11 +124,34 @@ export class Lecture {
       // (a line cut already at the top is taller than the screen: a whole screen of it then)
       const line = parseFloat(getComputedStyle(document.documentElement).fontSize) || 16;
       const by = cut && cut.top - top - 8 > 2 * line ? Math.min(cut.top - top - 8, page) : page;
-      window.scrollBy(0, Math.min(by, rest.bottom - innerHeight + 16));
+      window.scrollBy(0, this.#whole(current, Math.min(by, rest.bottom - innerHeight + 16), top, line));
     } else {
       return this.step(+1);
     }
     this.#count();
+  }
+
+  /** A scroll `by` adjusted so that no equation (nor title, row, figure) is cut by the header
+   * (a page ended with the lower half of an equation under it, student play-test): shortened so
+   * the first block under the header starts at its top, or, where that leaves less than two lines
+   * of progress (the last screen of a step), lengthened past a block already seen whole on this
+   * screen. A block taller than the screen is paged through as it is. */
+  #whole(current, by, top, line) {
+    const blocks = [...current.querySelectorAll(".math-line, h3, figure, summary, tr, mjx-container[display='true']")]
+      .filter(shown).map((b) => b.getBoundingClientRect()).filter((r) => r.height > 0);
+    const page = this.#page();
+    let at = by;
+    for (let k = 0; k < 4; k++) { // a new edge can cut another block: again from there
+      const edge = top + at, cut = blocks.filter((r) => r.top < edge - 1 && r.bottom > edge + 12);
+      if (!cut.length) break;
+      // the outermost block that can start the screen (a broken equation from its first line)
+      const back = cut.map((r) => r.top - top - 8).filter((to) => to >= 2 * line && to < at);
+      const past = Math.max(...cut.map((r) => r.bottom - top));
+      if (back.length) at = Math.min(...back);
+      else if (past > at && past <= page) at = past;
+      else break;
+    }
+    return at;
   }
 
   /** The screen above while the current step began above it, else hide the current step. */
@@ -214,6 +237,17 @@ export class Lecture {
       this.#count();
     });
   }
+}
+
+/** The step (from 1, as the header counts: "step 5 of 8") a link's ?step= opens at, or null.
+ * Addresses counted from 0 until November 2026: step=0 (only ever written by them) is the first
+ * step, and an older link otherwise opens one step further on (a step more revealed, nothing
+ * lost). A share link (?share=) is the exception: the share API's lecture_step still counts from
+ * 0 and the server writes it as it is. */
+export function linkedStep(query) {
+  const step = query.has("step") ? Number(query.get("step")) : NaN;
+  if (!Number.isInteger(step)) return null;
+  return Math.max(1, query.has("share") ? step + 1 : step);
 }
 
 /** Not folded away: a closed <details> keeps its contents' last geometry (Chromium lays them out

@@ -19,7 +19,7 @@ import { showEquilibria } from "./equilibria.js";
 import { fitEquations } from "./fit.js";
 import { drawFBD, fbdLegend } from "./fbd.js";
 import { fmt, isFixed, mountIntegrator, readSettings, showStats, showWarnings } from "./integrator.js";
-import { Lecture } from "./lecture.js";
+import { Lecture, linkedStep } from "./lecture.js";
 import { LiveModel, PREVIEW_LABEL, forDisplay } from "./live.js";
 import { BodyDrag } from "./livedrag.js";
 import { loadPlotly } from "./lazy.js";
@@ -114,9 +114,8 @@ class SceneView {
       onPlay: () => this.togglePlay(),
       onStep: () => this.#saveURL(), // the address bar keeps the step the room is at
     });
-    // a share link's lecture step (0: the first), revealed once the steps are there
-    const step = query.has("step") ? Number(query.get("step")) : NaN;
-    this.wantedSteps = Number.isInteger(step) && step >= 0 ? step + 1 : null;
+    // a link's lecture step (as the header counts it, from 1), revealed once the steps are there
+    this.wantedSteps = linkedStep(query);
     this.lecture.set(query.get("lecture") === "1");
     watchWorkInputs(() => this.#plot());
     $("phase-q").addEventListener("change", () => { this.phase = $("phase-q").value; this.#saveURL(); this.#plot(); });
@@ -220,7 +219,7 @@ class SceneView {
     }));
     if (this.phase && this.phase !== this.spec.coordinates[0]) q.set("phase", this.phase);
     // (a link's step is kept while the derivation it waits for is on its way)
-    if (this.lecture.on) q.set("step", String((this.wantedSteps || this.lecture.revealed) - 1));
+    if (this.lecture.on) q.set("step", String(this.wantedSteps || this.lecture.revealed));
     if (!this.sceneId) {
       const from = new URLSearchParams(location.search).get("from");
       if (from) q.set("from", from);

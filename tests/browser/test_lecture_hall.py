@@ -101,10 +101,10 @@ def test_the_step_counter_is_always_in_view(server, browser, size):
 
 def test_a_linked_step_opens_there_and_the_address_follows_the_steps(server, browser):
     with projector(browser, 1280, 720) as (p, errors):
-        open_lecture(p, f"{server}/scenes/atwood_machine?lecture=1&step=3")
+        open_lecture(p, f"{server}/scenes/atwood_machine?lecture=1&step=4")
         ids = steps_of(p)
-        # the fourth step (step=3 counts from 0), its title under the header once the math above
-        # it is typeset
+        # the fourth step (step=4 counts from 1, as the header does), its title under the header
+        # once the math above it is typeset
         p.wait_for_function(
             f"""() => {{ const at = ({PLACE})();
                 return at.top >= at.header - 1 && at.top <= at.header + {HALL_PX}; }}""",
@@ -119,9 +119,9 @@ def test_a_linked_step_opens_there_and_the_address_follows_the_steps(server, bro
             if p.get_attribute("#steps", "data-revealed") == "5":
                 break
         assert p.evaluate(PLACE)["step"] == ids[4]
-        assert "step=4" in p.evaluate("location.search")  # the address keeps the place
+        assert "step=5" in p.evaluate("location.search")  # the address keeps the place
         press(p, "ArrowLeft")
-        assert "step=3" in p.evaluate("location.search")
+        assert "step=4" in p.evaluate("location.search")
         assert errors == []
 
 
@@ -182,7 +182,7 @@ def test_labels_are_legible_from_the_back_of_the_hall(server, browser):
 
 def test_the_answer_field_takes_the_row(server, browser):
     with projector(browser, 1024, 768) as (p, errors):
-        open_lecture(p, f"{server}/scenes/simple_pendulum?lecture=1&step=3")
+        open_lecture(p, f"{server}/scenes/simple_pendulum?lecture=1&step=4")
         box = p.locator("li[data-step='energy'] details.yourturn").first
         box.locator("summary").click()
         widths = p.evaluate(

@@ -19,7 +19,9 @@ def address_step(p) -> str | None:
 
 @pytest.mark.parametrize(
     "asked,shown",
-    [("99", "last"), ("-3", 0), ("abc", 0), ("3", 3)],
+    # step= counts from 1, as the header does ("step 3 of 8" is step=3); an old link's step=0
+    # (they counted from 0) is the first
+    [("99", "last"), ("-3", 0), ("abc", 0), ("3", 2), ("0", 0)],
 )
 def test_the_address_says_the_step_shown(server, browser, asked, shown):
     with projector(browser, 1280, 720) as (p, errors):
@@ -29,7 +31,7 @@ def test_the_address_says_the_step_shown(server, browser, asked, shown):
         # the page shows step index + 1 (counted from 1), and the address says the same step
         assert p.get_attribute("#steps", "data-revealed") == str(index + 1)
         assert p.inner_text("#step-counter").startswith(f"step {index + 1} of {n}")
-        assert address_step(p) == str(index)
+        assert address_step(p) == str(index + 1)
         assert errors == []
 
 
