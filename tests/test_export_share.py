@@ -69,7 +69,7 @@ def test_a_builtin_scenes_state_round_trips_exactly():
     assert (query["method"], float(query["dt"]), float(query["t_end"])) == ("rk4", 0.005, 17.25)
     assert (query["lecture"], query["step"], query["compare"], query["method_b"]) == (
         "1",
-        "5",
+        "6",  # lecture_step 5 (from 0) is the page's step=6 (from 1, as its header counts)
         "1",
         "euler",
     )

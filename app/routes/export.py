@@ -593,7 +593,7 @@ def page_query(state: ShareState) -> str:
     if state.lecture:
         query.append(("lecture", "1"))
     if state.lecture_step is not None:
-        query.append(("step", str(state.lecture_step)))
+        query.append(("step", str(state.lecture_step + 1)))  # the page counts from 1
     if state.phase is not None:
         query.append(("phase", state.phase))
     return urlencode(query)

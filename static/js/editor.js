@@ -73,7 +73,7 @@ function sharedQuery(state, token) {
   if (state.compare) q.set("compare", "1");
   if (state.method_b) q.set("method_b", state.method_b);
   if (state.lecture) q.set("lecture", "1");
-  if (state.lecture_step != null) q.set("step", String(state.lecture_step));
+  if (state.lecture_step != null) q.set("step", String(state.lecture_step + 1)); // the page counts from 1
   if (state.phase) q.set("phase", state.phase);
   q.set("share", token);
   return q;

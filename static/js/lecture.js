@@ -242,12 +242,11 @@ export class Lecture {
 /** The step (from 1, as the header counts: "step 5 of 8") a link's ?step= opens at, or null.
  * Addresses counted from 0 until November 2026: step=0 (only ever written by them) is the first
  * step, and an older link otherwise opens one step further on (a step more revealed, nothing
- * lost). A share link (?share=) is the exception: the share API's lecture_step still counts from
- * 0 and the server writes it as it is. */
+ * lost). (A share link's lecture_step counts from 0 in the API; the link adds 1.) */
 export function linkedStep(query) {
   const step = query.has("step") ? Number(query.get("step")) : NaN;
   if (!Number.isInteger(step)) return null;
-  return Math.max(1, query.has("share") ? step + 1 : step);
+  return Math.max(1, step);
 }
 
 /** Not folded away: a closed <details> keeps its contents' last geometry (Chromium lays them out
