@@ -199,7 +199,7 @@ def drive_works_somewhere(model: Model, work: Work, drive: sp.Expr) -> bool:
     for values in probe_states(model):
         try:
             if work.accelerations is not None:
-                qdd = [sp.sympify(a).xreplace(to_sym).xreplace(values) for a in work.accelerations]
+                qdd = [_expr(a).xreplace(to_sym).xreplace(values) for a in work.accelerations]
             else:
                 M = work.mass_matrix.xreplace(to_sym).xreplace(values).evalf(30)
                 f = work.forcing.xreplace(to_sym).xreplace(values).evalf(30)
@@ -216,6 +216,16 @@ def drive_works_somewhere(model: Model, work: Work, drive: sp.Expr) -> bool:
     return False
 
 
+def _expr(a: object) -> sp.Basic:
+    """A solved acceleration as sympy: the engine's own expressions (never text; a plain 0 may
+    come as an int)."""
+    if isinstance(a, sp.Basic):
+        return a
+    if isinstance(a, int):
+        return sp.Integer(a)
+    return sp.Float(float(a))
+
+
 def drive_rate_vanishes(model: Model, work: Work, drive: sp.Expr) -> bool:
     """Does d(E − h)/dt, q̈ taken from the solved equations of motion, simplify to 0? A proof
     that E − h is constant along every motion where no conserved momentum shows it (a puck on a
@@ -225,7 +235,7 @@ def drive_rate_vanishes(model: Model, work: Work, drive: sp.Expr) -> bool:
         return False
     to_sym, _ = _symbols_for(model)
     solved = {
-        to_sym[x]: sp.sympify(a).xreplace(to_sym)
+        to_sym[x]: _expr(a).xreplace(to_sym)
         for x, a in zip(model.qdd, work.accelerations, strict=True)
     }
     rate = d_dt(drive, model).xreplace(to_sym).xreplace(solved)
