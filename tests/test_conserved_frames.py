@@ -13,6 +13,7 @@ import json
 import numpy as np
 import pytest
 from independent import own_run
+from specs_beyond import turntable_cartesian
 
 from mechanics.derive import derivation_of_scene, derive_model
 from mechanics.scenes import load_scene
@@ -45,23 +46,7 @@ TURNTABLE = {
 }
 
 # the same puck in Cartesian coordinates of the turning frame: no cyclic coordinate
-CARTESIAN = {
-    "title": "rotating cartesian",
-    "coordinates": ["x", "y"],
-    "parameters": {"m": 1.0, "k": 4.0, "Omega": 2.0},
-    "initial": {"x": 0.1, "y": 0.0, "x_dot": 0.2, "y_dot": 0.1},
-    "frames": [{"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"}],
-    "points": [{"name": "o", "position": [0, 0, 0]}],
-    "bodies": [
-        {
-            "name": "p",
-            "kind": "particle",
-            "mass": "m",
-            "position": {"frame": "H", "components": ["x", "y", 0]},
-        }
-    ],
-    "springs": [{"name": "s", "a": "o", "b": "p", "k": "k", "rest_length": 0}],
-}
+CARTESIAN = turntable_cartesian()
 
 # a bead on the wire y = a r² spun at Ω about the vertical, with friction against the wire
 PARABOLA = {

@@ -15,6 +15,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from specs_beyond import ladder, turntable_cartesian
 
 from mechanics.derive import derive_model
 from mechanics.equilibria import equilibria
@@ -51,27 +52,6 @@ def turntable(positive: bool = False) -> dict:
     return spec
 
 
-def turntable_cartesian() -> dict:
-    """The same puck in Cartesian coordinates of the turning frame (spec_rotcrit.json)."""
-    return {
-        "title": "rotating cartesian",
-        "coordinates": ["x", "y"],
-        "parameters": {"m": 1.0, "k": 4.0, "Omega": 2.0},
-        "initial": {"x": 0.1, "y": 0.0},
-        "frames": [{"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"}],
-        "points": [{"name": "o", "position": [0, 0, 0]}],
-        "bodies": [
-            {
-                "name": "p",
-                "kind": "particle",
-                "mass": "m",
-                "position": {"frame": "H", "components": ["x", "y", 0]},
-            }
-        ],
-        "springs": [{"name": "s", "a": "o", "b": "p", "k": "k", "rest_length": 0}],
-    }
-
-
 SPHERE = {
     "title": "spherical pendulum in a turning frame",
     "coordinates": ["theta", "phi"],
@@ -93,32 +73,7 @@ SPHERE = {
     "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
 }
 
-LADDER = {
-    "title": "ladder",
-    "coordinates": ["theta"],
-    "parameters": {"m": 1.0, "L": 2.0, "g": 9.81},
-    "initial": {"theta": 0.3, "theta_dot": 0.0},
-    "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
-    "bodies": [
-        {
-            "name": "ladder",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "R",
-            "position": ["L/2*sin(theta)", "L/2*cos(theta)", 0],
-            "inertia": {"ixx": "m*L**2/12", "iyy": 0, "izz": "m*L**2/12"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-    "stops": [
-        {
-            "name": "wall_contact",
-            "tension": "ladder",
-            "along": [1, 0, 0],
-            "message": "the top leaves the wall",
-        }
-    ],
-}
+LADDER = ladder()
 
 
 def at(out: dict, **q: float) -> dict:

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from fastapi.testclient import TestClient
+from specs_beyond import ladder
 
 from app.main import app
 from mechanics.derive import derive, derive_model, derive_scene
@@ -24,32 +25,7 @@ from mechanics.newton import newton
 
 client = TestClient(app)
 
-LADDER = {
-    "title": "ladder",
-    "coordinates": ["theta"],
-    "parameters": {"m": 1.0, "L": 2.0, "g": 9.81},
-    "initial": {"theta": 0.3, "theta_dot": 0.0},
-    "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
-    "bodies": [
-        {
-            "name": "ladder",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "R",
-            "position": ["L/2*sin(theta)", "L/2*cos(theta)", 0],
-            "inertia": {"ixx": "m*L**2/12", "iyy": 0, "izz": "m*L**2/12"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-    "stops": [
-        {
-            "name": "wall_contact",
-            "tension": "ladder",
-            "along": [1, 0, 0],
-            "message": "the top leaves the wall",
-        }
-    ],
-}
+LADDER = ladder()
 
 #: A cylinder of radius r rolling inside a fixed cylinder of radius R (the play-test's spec).
 CYLINDER = {

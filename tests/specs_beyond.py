@@ -1,0 +1,65 @@
+"""Systems beyond the catalog that several test modules pose (the physics play-tests' specs), in
+one place so a fix to one spec is a fix to all: each module still derives its own expectations.
+"""
+
+from __future__ import annotations
+
+import copy
+
+#: A frictionless ladder, top on the wall x = 0, foot on the floor y = 0: θ from the wall, G at
+#: (L/2 sin θ, L/2 cos θ). The wall can only push: the run stops where its force would pull.
+_LADDER = {
+    "title": "ladder",
+    "coordinates": ["theta"],
+    "parameters": {"m": 1.0, "L": 2.0, "g": 9.81},
+    "initial": {"theta": 0.3, "theta_dot": 0.0},
+    "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
+    "bodies": [
+        {
+            "name": "ladder",
+            "kind": "rigid_body",
+            "mass": "m",
+            "frame": "R",
+            "position": ["L/2*sin(theta)", "L/2*cos(theta)", 0],
+            "inertia": {"ixx": "m*L**2/12", "iyy": 0, "izz": "m*L**2/12"},
+        }
+    ],
+    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+    "stops": [
+        {
+            "name": "wall_contact",
+            "tension": "ladder",
+            "along": [1, 0, 0],
+            "message": "the top leaves the wall",
+        }
+    ],
+}
+
+#: A puck on a frictionless turntable turning at Ω, on a spring of rest length 0 to the axis, in
+#: Cartesian coordinates of the turning frame (no cyclic coordinate).
+_TURNTABLE_CARTESIAN = {
+    "title": "rotating cartesian",
+    "coordinates": ["x", "y"],
+    "parameters": {"m": 1.0, "k": 4.0, "Omega": 2.0},
+    "initial": {"x": 0.1, "y": 0.0, "x_dot": 0.2, "y_dot": 0.1},
+    "frames": [{"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"}],
+    "points": [{"name": "o", "position": [0, 0, 0]}],
+    "bodies": [
+        {
+            "name": "p",
+            "kind": "particle",
+            "mass": "m",
+            "position": {"frame": "H", "components": ["x", "y", 0]},
+        }
+    ],
+    "springs": [{"name": "s", "a": "o", "b": "p", "k": "k", "rest_length": 0}],
+}
+
+
+def ladder() -> dict:
+    """A fresh copy: tests change parameters and stops."""
+    return copy.deepcopy(_LADDER)
+
+
+def turntable_cartesian() -> dict:
+    return copy.deepcopy(_TURNTABLE_CARTESIAN)
