@@ -84,7 +84,7 @@ log = logging.getLogger(__name__)
 
 #: Bump when the output of any store changes (a derivation step, equilibria, the generated C...),
 #: so entries of the old engine are never served. Part of every key and every entry.
-ENGINE_VERSION = "16"
+ENGINE_VERSION = "17"
 
 ENV_VAR = "LAGRANGE_LAB_CACHE"
 REDIS_ENV_VAR = "LAGRANGE_LAB_REDIS_URL"

@@ -2466,7 +2466,8 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
     if k_null > n_free:
         return (
             "marginal",
-            "$\\mathbf K$ is singular in a direction that is not a free coordinate (eigenvalues "
+            "$\\mathbf K$ is singular in a direction that is not a free coordinate (the motion's "
+            "eigenvalues "
             f"{shown}): the quadratic approximation is flat there, so the linear test cannot "
             "decide; higher-order terms do (a bifurcation point, or a family of equilibria)",
             lam,
@@ -2523,7 +2524,9 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
             )
         if damped:
             reason += ", and damping makes the motion decay"
-        return "stable", reason + f" (eigenvalues {shown}){free_note}", lam, vecs
+        # the λ are the linearized motion's, not K's (a student read "K ... (eigenvalues ±2.4i)"
+        # as K having imaginary eigenvalues)
+        return "stable", reason + f" (the motion's eigenvalues {shown}){free_note}", lam, vecs
     on_axis = moving[np.abs(moving.real) <= tol]
     semisimple = _semisimple(A, on_axis, scale)
     if (

@@ -65,6 +65,8 @@ def test_both_sides_of_the_anchor_each_bob_up_and_down(rest):
         assert e["stable"] is stable, e
         if stable:
             assert e["frequencies"] == pytest.approx(omegas, rel=1e-9)
+            # whose eigenvalues ±ωi are: the motion's, not K's (K's are real and positive)
+            assert "the motion's eigenvalues" in e["reason"], e["reason"]
         # each is recognised: −2ℓ₀ is −2 L0 whatever else equals 2 (M = 2 at the defaults)
         assert e["symbolic"]["x"] == ("0" if e["q"]["x"] == 0 else "-2*L0"), e
         assert e["symbolic"]["theta"] in ("0", "pi")
