@@ -56,6 +56,29 @@ _TURNTABLE_CARTESIAN = {
 }
 
 
+#: The same puck in polar coordinates (r, φ) of the turning frame: φ is cyclic, so p_φ is conserved.
+_TURNTABLE_POLAR = {
+    "title": "turntable polar",
+    "coordinates": ["r", "phi"],
+    "parameters": {"m": 1.0, "k": 4.0, "Omega": 1.5},
+    "initial": {"r": 1.0, "phi": 0.0, "r_dot": 0.3, "phi_dot": 0.5},
+    "frames": [
+        {"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"},
+        {"name": "P", "parent": "H", "axis": "z", "angle": "phi"},
+    ],
+    "points": [{"name": "centre", "position": [0, 0, 0]}],
+    "bodies": [
+        {
+            "name": "puck",
+            "kind": "particle",
+            "mass": "m",
+            "position": {"frame": "P", "components": ["r", 0, 0]},
+        }
+    ],
+    "springs": [{"name": "s", "a": "centre", "b": "puck", "k": "k", "rest_length": 0}],
+}
+
+
 def ladder() -> dict:
     """A fresh copy: tests change parameters and stops."""
     return copy.deepcopy(_LADDER)
@@ -63,3 +86,11 @@ def ladder() -> dict:
 
 def turntable_cartesian() -> dict:
     return copy.deepcopy(_TURNTABLE_CARTESIAN)
+
+
+def turntable_polar(positive: bool = False) -> dict:
+    """With ``positive``, r is declared positive (the pole r = 0 is then outside the states)."""
+    spec = copy.deepcopy(_TURNTABLE_POLAR)
+    if positive:
+        spec["positive_coordinates"] = ["r"]
+    return spec

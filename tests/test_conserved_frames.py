@@ -13,7 +13,7 @@ import json
 import numpy as np
 import pytest
 from independent import own_run
-from specs_beyond import turntable_cartesian
+from specs_beyond import turntable_cartesian, turntable_polar
 
 from mechanics.derive import derivation_of_scene, derive_model
 from mechanics.scenes import load_scene
@@ -23,27 +23,7 @@ TIGHT = {"rtol": 1e-11, "atol": 1e-12}
 
 # a puck on a frictionless turntable turning at Ω, held by a spring of rest length 0 to the
 # centre; (r, φ) measured in the turntable's frame H
-TURNTABLE = {
-    "title": "turntable polar",
-    "coordinates": ["r", "phi"],
-    "positive_coordinates": ["r"],
-    "parameters": {"m": 1.0, "k": 4.0, "Omega": 1.5},
-    "initial": {"r": 1.0, "phi": 0.0, "r_dot": 0.3, "phi_dot": 0.5},
-    "frames": [
-        {"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"},
-        {"name": "P", "parent": "H", "axis": "z", "angle": "phi"},
-    ],
-    "points": [{"name": "centre", "position": [0, 0, 0]}],
-    "bodies": [
-        {
-            "name": "puck",
-            "kind": "particle",
-            "mass": "m",
-            "position": {"frame": "P", "components": ["r", 0, 0]},
-        }
-    ],
-    "springs": [{"name": "s", "a": "centre", "b": "puck", "k": "k", "rest_length": 0}],
-}
+TURNTABLE = turntable_polar(positive=True)
 
 # the same puck in Cartesian coordinates of the turning frame: no cyclic coordinate
 CARTESIAN = turntable_cartesian()

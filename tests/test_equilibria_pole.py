@@ -15,42 +15,13 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
-from specs_beyond import ladder, turntable_cartesian
+from specs_beyond import ladder, turntable_cartesian, turntable_polar
 
 from mechanics.derive import derive_model
 from mechanics.equilibria import equilibria
 from mechanics.numeric import compile_derivation
 from mechanics.spec import SpecError
 from mechanics.stops import refuse_passed_stops
-
-
-def turntable(positive: bool = False) -> dict:
-    """A puck on a turntable turning at Ω, on a spring of rest length 0 to the centre, in polar
-    coordinates of the turning frame (the play-test's spec_turntable*.json)."""
-    spec = {
-        "title": "turntable polar",
-        "coordinates": ["r", "phi"],
-        "parameters": {"m": 1.0, "k": 4.0, "Omega": 1.5},
-        "initial": {"r": 1.0, "phi": 0.0},
-        "frames": [
-            {"name": "H", "parent": "N", "axis": "z", "angle": "Omega*t"},
-            {"name": "P", "parent": "H", "axis": "z", "angle": "phi"},
-        ],
-        "points": [{"name": "centre", "position": [0, 0, 0]}],
-        "bodies": [
-            {
-                "name": "puck",
-                "kind": "particle",
-                "mass": "m",
-                "position": {"frame": "P", "components": ["r", 0, 0]},
-            }
-        ],
-        "springs": [{"name": "s", "a": "centre", "b": "puck", "k": "k", "rest_length": 0}],
-    }
-    if positive:
-        spec["positive_coordinates"] = ["r"]
-    return spec
-
 
 SPHERE = {
     "title": "spherical pendulum in a turning frame",
@@ -97,7 +68,7 @@ def test_the_turntable_origin_oscillates_at_the_split_frequencies(k):
     m, omega = 1.0, 1.5
     w0 = math.sqrt(k / m)
     expected = sorted([abs(w0 - omega), w0 + omega])
-    e = at(equilibria(derive_model(turntable()), {"k": k, "Omega": omega}), r=0.0)
+    e = at(equilibria(derive_model(turntable_polar()), {"k": k, "Omega": omega}), r=0.0)
     assert e["kind"] == ("gyroscopically stable" if k < m * omega**2 else "stable")
     assert e["frequencies"] == pytest.approx(expected, rel=1e-9)
     assert imaginary_parts(e) == pytest.approx(
@@ -120,7 +91,7 @@ def test_a_damped_turntable_origin_decays_with_the_coriolis_split():
     K = (k - m * omega**2) * np.eye(2)
     A = np.block([[np.zeros((2, 2)), np.eye(2)], [-K / m, -C / m]])
     expected = sorted(np.linalg.eigvals(A), key=lambda z: (z.imag, z.real))
-    spec = turntable()
+    spec = turntable_polar()
     spec["parameters"]["c"] = c
     spec["forces"] = [
         {
@@ -202,14 +173,14 @@ def test_a_family_along_a_positive_coordinate_is_shown_inside_it():
     K = 0 and Coriolis C_rφ = −2mΩr, C_φr = 2mΩr give λ⁴ + 4Ω²λ² = 0: λ = 0, 0, ±2iΩ (the
     Cartesian spec's 'bounded loop, λ = 0, 0, ±4i' at Ω = 2)."""
     omega = 1.5
-    out = equilibria(derive_model(turntable(positive=True)), {"k": 2.25, "Omega": omega})
+    out = equilibria(derive_model(turntable_polar(positive=True)), {"k": 2.25, "Omega": omega})
     assert out["equilibria"], out["warnings"]
     assert all(e["q"]["r"] > 0 for e in out["equilibria"])
     (e,) = out["equilibria"]
     assert imaginary_parts(e) == pytest.approx([-2 * omega, 0.0, 0.0, 2 * omega], abs=1e-9)
     assert any("r is declared positive" in w for w in out["warnings"])
     # k = 1: the origin is the only balance, on the excluded edge: not listed (as before)
-    out = equilibria(derive_model(turntable(positive=True)), {"k": 1.0, "Omega": omega})
+    out = equilibria(derive_model(turntable_polar(positive=True)), {"k": 1.0, "Omega": omega})
     assert out["equilibria"] == []
 
 
