@@ -35,6 +35,27 @@ _LADDER = {
     ],
 }
 
+#: A uniform cylinder of radius r rolling without slipping inside a fixed one of radius R: its
+#: frame turns by −(R − r)θ/r as its centre goes round at angle θ.
+_CYLINDER_IN_CYLINDER = {
+    "title": "cyl in cyl",
+    "coordinates": ["theta"],
+    "parameters": {"m": 2.0, "R": 1.0, "r": 0.25, "g": 9.81},
+    "initial": {"theta": 0.4, "theta_dot": 0.0},
+    "frames": [{"name": "D", "parent": "N", "axis": "z", "angle": "-(R-r)*theta/r"}],
+    "bodies": [
+        {
+            "name": "cyl",
+            "kind": "rigid_body",
+            "mass": "m",
+            "frame": "D",
+            "position": ["(R-r)*sin(theta)", "-(R-r)*cos(theta)", 0],
+            "inertia": {"ixx": "m*r**2/4", "iyy": "m*r**2/4", "izz": "m*r**2/2"},
+        }
+    ],
+    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+}
+
 #: A puck on a frictionless turntable turning at Ω, on a spring of rest length 0 to the axis, in
 #: Cartesian coordinates of the turning frame (no cyclic coordinate).
 _TURNTABLE_CARTESIAN = {
@@ -79,9 +100,17 @@ _TURNTABLE_POLAR = {
 }
 
 
-def ladder() -> dict:
-    """A fresh copy: tests change parameters and stops."""
-    return copy.deepcopy(_LADDER)
+def ladder(stops: bool = True) -> dict:
+    """A fresh copy: tests change parameters and stops. Without ``stops`` the run goes on past
+    where the top would leave the wall (a drawing test pauses at the start)."""
+    spec = copy.deepcopy(_LADDER)
+    if not stops:
+        del spec["stops"]
+    return spec
+
+
+def cylinder_in_cylinder() -> dict:
+    return copy.deepcopy(_CYLINDER_IN_CYLINDER)
 
 
 def turntable_cartesian() -> dict:

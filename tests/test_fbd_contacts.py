@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from fastapi.testclient import TestClient
-from specs_beyond import ladder
+from specs_beyond import cylinder_in_cylinder, ladder
 
 from app.main import app
 from mechanics.derive import derive, derive_model, derive_scene
@@ -28,24 +28,7 @@ client = TestClient(app)
 LADDER = ladder()
 
 #: A cylinder of radius r rolling inside a fixed cylinder of radius R (the play-test's spec).
-CYLINDER = {
-    "title": "cyl in cyl",
-    "coordinates": ["theta"],
-    "parameters": {"m": 2.0, "R": 1.0, "r": 0.25, "g": 9.81},
-    "initial": {"theta": 0.4, "theta_dot": 0.0},
-    "frames": [{"name": "D", "parent": "N", "axis": "z", "angle": "-(R-r)*theta/r"}],
-    "bodies": [
-        {
-            "name": "cyl",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "D",
-            "position": ["(R-r)*sin(theta)", "-(R-r)*cos(theta)", 0],
-            "inertia": {"ixx": "m*r**2/4", "iyy": "m*r**2/4", "izz": "m*r**2/2"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-}
+CYLINDER = cylinder_in_cylinder()
 
 
 def fbd(spec: dict) -> dict:

@@ -11,6 +11,7 @@ import json
 import math
 
 import pytest
+from specs_beyond import cylinder_in_cylinder, ladder
 from test_drawing import GREY_NEAR, pause, post_in_editor, project
 
 pytestmark = pytest.mark.browser
@@ -34,45 +35,12 @@ BLUE_NEAR = """([points, reach]) => {
   });
 }"""
 
-R_OUT, R_IN, THETA0 = 1.0, 0.25, 0.4
-CYLINDER = {
-    "title": "cyl in cyl",
-    "coordinates": ["theta"],
-    "parameters": {"m": 2.0, "R": R_OUT, "r": R_IN, "g": 9.81},
-    "initial": {"theta": THETA0, "theta_dot": 0.0},
-    "frames": [{"name": "D", "parent": "N", "axis": "z", "angle": "-(R-r)*theta/r"}],
-    "bodies": [
-        {
-            "name": "cyl",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "D",
-            "position": ["(R-r)*sin(theta)", "-(R-r)*cos(theta)", 0],
-            "inertia": {"ixx": "m*r**2/4", "iyy": "m*r**2/4", "izz": "m*r**2/2"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-}
+CYLINDER = cylinder_in_cylinder()
+R_OUT, R_IN = CYLINDER["parameters"]["R"], CYLINDER["parameters"]["r"]
+THETA0 = CYLINDER["initial"]["theta"]
 
-L, PHI0 = 2.0, 0.3
-LADDER = {
-    "title": "ladder",
-    "coordinates": ["theta"],
-    "parameters": {"m": 1.0, "L": L, "g": 9.81},
-    "initial": {"theta": PHI0, "theta_dot": 0.0},
-    "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
-    "bodies": [
-        {
-            "name": "ladder",
-            "kind": "rigid_body",
-            "mass": "m",
-            "frame": "R",
-            "position": ["L/2*sin(theta)", "L/2*cos(theta)", 0],
-            "inertia": {"ixx": "m*L**2/12", "iyy": 0, "izz": "m*L**2/12"},
-        }
-    ],
-    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-}
+LADDER = ladder(stops=False)  # paused at its start: the run need not stop where the top leaves
+L, PHI0 = LADDER["parameters"]["L"], LADDER["initial"]["theta"]
 
 #: A rod pivoted at O like the catalog's physical pendulum, but placed by components in N: only
 #: the run shows that O is a point of it (fixed in its frame R, seen from G).
