@@ -10,19 +10,33 @@ import tempfile
 import pytest
 
 _saved: dict[str, str | None] = {}
+_owned: list[str] = []
+#: The session's cache folder, as the controller made it (read by xdist workers).
+_SESSION_CACHE = "LAGRANGE_LAB_TEST_SESSION_CACHE"
 
 
 def pytest_configure(config: pytest.Config) -> None:
     # At configure time, before collection, so even import-time code sees the private folder.
+    # One folder per test session: the xdist controller makes it, its workers (and the servers and
+    # pool workers they start) inherit it through the environment, so a scene derived and compiled
+    # by one process is read by the others instead of being derived again in each.
     _saved["LAGRANGE_LAB_CACHE"] = os.environ.get("LAGRANGE_LAB_CACHE")
-    os.environ["LAGRANGE_LAB_CACHE"] = tempfile.mkdtemp(prefix="lagrange-lab-cache-")
+    inherited = os.environ.get(_SESSION_CACHE) if hasattr(config, "workerinput") else None
+    if inherited and os.path.isdir(inherited):
+        os.environ["LAGRANGE_LAB_CACHE"] = inherited
+    else:
+        folder = tempfile.mkdtemp(prefix="lagrange-lab-cache-")
+        os.environ["LAGRANGE_LAB_CACHE"] = folder
+        os.environ[_SESSION_CACHE] = folder
+        _owned.append(folder)
     # The servers tests start do not warm every scene in the background (2 cores: it would slow
     # every other test); tests/test_warm_up.py switches it on where it is the subject.
     os.environ.setdefault("LAGRANGE_LAB_WARM", "0")
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    shutil.rmtree(os.environ["LAGRANGE_LAB_CACHE"], ignore_errors=True)
+    for folder in _owned:  # only the process that made the session's folder removes it
+        shutil.rmtree(folder, ignore_errors=True)
     if _saved.get("LAGRANGE_LAB_CACHE") is None:
         os.environ.pop("LAGRANGE_LAB_CACHE", None)
     else:

@@ -26,10 +26,11 @@ if not Path(CHROMIUM).exists():  # CI installs it; a bare laptop skips with a re
 
 
 @pytest.fixture(scope="session")
-def server(tmp_path_factory) -> str:
-    """The app under uvicorn in a subprocess, with its derivation cache in a fresh folder."""
+def server() -> str:
+    """The app under uvicorn in a subprocess. Its derivation cache is the test session's own folder
+    (tests/conftest.py), so a scene another worker or test already derived is not derived again."""
     port = free_port()
-    env = {**os.environ, "LAGRANGE_LAB_CACHE": str(tmp_path_factory.mktemp("cache"))}
+    env = dict(os.environ)
     command = [sys.executable, "-m", "uvicorn", "app.main:app", "--port", str(port)]
     with serving([*command, "--log-level", "warning"], port, env=env, cwd=ROOT) as (url, _):
         yield url

@@ -15,7 +15,7 @@ import json
 from urllib.parse import parse_qs, urlparse
 
 import pytest
-from test_polish import api  # a GET or POST of the API, its JSON answer
+from test_scene_page_details import api  # a GET or POST of the API, its JSON answer
 
 pytestmark = pytest.mark.browser
 

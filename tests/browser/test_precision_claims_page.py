@@ -4,7 +4,7 @@ The hostile play-test's page showed a damped oscillator's long run with an energ
 6680 % of max T and no caveat, an Atwood machine's "1000 periods" past the moment its mass
 reaches the pulley, and a chaotic run's every point as "not converging yet". What the page must
 say instead is checked here against values worked out by hand (Atwood's stop at
-√(2 (l + d)/(g/3)) ≈ 0.892 s); the API's reasons are checked in tests/test_precision_trust.py.
+√(2 (l + d)/(g/3)) ≈ 0.892 s); the API's reasons are checked in tests/test_precision_claims.py.
 """
 
 from __future__ import annotations
