@@ -199,8 +199,9 @@ class SimulateRequest(DeriveRequest):
         "whole number of its steps nearest 1/fps instead (stats.sample_interval).",
     )
     method: MethodName = Field(  # type: ignore[valid-type]
-        default="DOP853",
-        description="euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
+        default="dop853_c",
+        description="Default dop853_c: DOP853's steps in C (scipy's DOP853 where C cannot run; "
+        "stats.method names the one that ran). euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
         "RK45, DOP853, dop853_c, dop853_fortran, Radau, BDF, LSODA (adaptive: rtol, atol); "
         "`GET /api/v1/methods` lists each with its order and properties.",
     )
@@ -248,7 +249,7 @@ class SimulateStats(BaseModel):
 
     model_config = ConfigDict(extra="allow")
 
-    method: str
+    method: str = Field(description="The method that ran (method_requested: the one asked for).")
     steps: int
     rhs_evaluations: int
     jacobian_evaluations: int

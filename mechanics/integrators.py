@@ -111,6 +111,9 @@ class Trajectory:
     #: The last state the stepping reached (at t_reached; None where the C or Fortran loop ran):
     #: when a run stops, how large the state had grown tells a blow-up from stiffness.
     y_reached: np.ndarray | None = None
+    #: The method that ran: the one asked for, or "DOP853" where ``dop853_c`` could not (``note``
+    #: says why). The answer's stats name it, so nobody reads scipy's timings as the C loop's.
+    method: str = ""
 
     def __post_init__(self) -> None:
         # Counters reach the JSON of a response: plain Python numbers, whatever counted them
@@ -266,7 +269,7 @@ def integrate(
         raise ValueError(f"{method} is a fixed-step method: give a finite step dt > 0")
     start = time.perf_counter()
     if len(t_eval) == 1:
-        return Trajectory(t_eval.copy(), y0[None, :].copy(), "ok", "", 0, 0, 0, 0.0)
+        return Trajectory(t_eval.copy(), y0[None, :].copy(), "ok", "", 0, 0, 0, 0.0, method=method)
 
     f, run = _Counted(rhs, max_wall_time, start), _Run(y0)
     f.stop_watch = watch
@@ -274,7 +277,9 @@ def integrate(
     if method == "dop853_c":
         why = native_code.available()
         if why is None:
-            return _compiled(native or f, y0, t_eval, rtol, atol, max_steps, max_wall_time, start)
+            run = _compiled(native or f, y0, t_eval, rtol, atol, max_steps, max_wall_time, start)
+            run.method = "dop853_c"
+            return run
         method, note = "DOP853", f"ran scipy's DOP853 (the same steps, slower): {why}"
     try:
         with np.errstate(all="ignore"):  # non-finite values are detected and reported, not warned
@@ -301,6 +306,7 @@ def integrate(
         f.t if status != "ok" else float(t_eval[-1]),
         run.step,
         run.last,
+        method,
     )
 
 

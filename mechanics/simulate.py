@@ -22,7 +22,6 @@ from mechanics.expr import to_plain
 from mechanics.integrators import _PHYSICAL, METHODS, Trajectory, integrate
 from mechanics.model import T as T_SYMBOL
 from mechanics.model import limits_along_run, physical_limit_errors
-from mechanics.native import NativeUnavailable
 from mechanics.numeric import (
     EXTREME_EXPONENT,
     CompiledScene,
@@ -33,6 +32,7 @@ from mechanics.numeric import (
     overflow_error,
     velocity_jump_functions,
 )
+from mechanics.scene_run import DEFAULT_METHOD, run_scene
 from mechanics.spec import SpecError
 from mechanics.steps.conserved import explicit_time, vanishes
 from mechanics.stops import (
@@ -40,7 +40,6 @@ from mechanics.stops import (
     first_stop,
     refuse_passed_stops,
     stopped_at_start,
-    watch_for_stops,
 )
 
 MAX_T_END = 1000.0
@@ -62,7 +61,7 @@ class SimulationRequest:
     initial: dict[str, float] = field(default_factory=dict)
     t_end: float = 10.0
     fps: float = 60.0
-    method: str = "DOP853"
+    method: str = DEFAULT_METHOD
     rtol: float = 1e-9
     atol: float = 1e-9
     dt: float | None = None
@@ -345,47 +344,10 @@ def _run(
     rtol: float,
     atol: float,
 ) -> Trajectory:
-    """One integration; a scene with stops gets a fresh `StopWatch` (``run.watch``).
-
-    The C loop is not watched: its samples are searched afterwards, which finds every smooth
-    stop. A stop where the motion reverses (friction sticking) makes the steps chatter at a
-    discontinuity instead of crossing it, so such scenes step in Python, watched every step.
-    """
-    compiled, why, method = None, "", req.method
-    watch = watch_for_stops(c, params, y0)
-    # a spring through its anchor crosses smoothly (found on the samples); friction chatters
-    chatter = any(stop.crossing == "any" and stop.kind != "anchor" for stop in c.stops)
-    domain = any(stop.kind == "domain" for stop in c.stops)
-    if method == "dop853_c" and (chatter or domain):
-        method = "DOP853"
-        why = "stepped by scipy's DOP853 (the same steps) so " + (
-            "a reversal is caught every step"
-            if chatter
-            else "the end of a position's domain, approached tangentially, is caught every step"
-        )
-    elif method == "dop853_c":
-        try:
-            compiled = c.native_rhs(params)
-        except NativeUnavailable as exc:
-            why = str(exc)  # the C loop calls the Python right-hand side back (or scipy runs it)
-            why = f"The equations could not be compiled to C ({why}): the C loop called Python."
-    run = integrate(
-        c.rhs(params),
-        y0,
-        t_eval,
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        dt=req.dt,
-        max_wall_time=MAX_WALL_TIME,
-        second_order=c.n,
-        native=compiled,
-        watch=watch,
-    )
-    if why and not run.note:
-        run.note = why[0].upper() + why[1:] if why.endswith(".") else f"This scene was {why}."
-    run.watch = watch
-    return run
+    """One integration of the request's method, or of the one that must run instead
+    (mechanics/scene_run.py says when and why; ``run.method`` names the one that ran)."""
+    kw = {"method": req.method, "dt": req.dt, "max_wall_time": MAX_WALL_TIME}
+    return run_scene(c, params, y0, t_eval, rtol=rtol, atol=atol, **kw)
 
 
 def fixed_step_grid(t_end: float, fps: float, dt: float) -> tuple[np.ndarray, int]:
@@ -505,7 +467,8 @@ def simulate_compiled(c: CompiledScene, req: SimulationRequest) -> dict[str, Any
     verdict = next((s.data or {} for s in c.derivation.steps if s.id == "conserved"), {})
     idle_drive = verdict.get("drive_work") == "none"
     stats: dict[str, Any] = {
-        "method": req.method,
+        "method": raw.method or req.method,  # the method that ran (scene_run.py)
+        "method_requested": req.method,
         "steps": run.nsteps,
         "rhs_evaluations": run.nfev,
         "jacobian_evaluations": run.njev,
