@@ -569,3 +569,8 @@ class NewtonResponse(BaseModel):
     )
     equations: dict[str, str] = Field(description="Newton's equations projected on each δq_j.")
     agrees_with_lagrange: bool
+    constraint_forces_unknown: str | None = Field(
+        default=None,
+        description="Why `constraint_forces` is empty (a potential given as V(q) fixes only "
+        "its virtual work, not its force across the constraints); null when they are given.",
+    )

@@ -21,6 +21,7 @@ from sympy.physics.vector import Vector
 
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
+from mechanics.newton_potentials import potential_virtual_work, unknown_constraint_forces
 from mechanics.steps import Line, Step, sub, tidy, vec_in, vec_line
 from mechanics.steps.fbd import body_forces, constraint_forces, resultant_name, rod_anchor
 
@@ -50,16 +51,13 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
     balance_lines: list[Line] = []
     forces: list[ConstraintForce] = []
     residual = [sp.S.Zero] * len(m.q)  # Σ_i (m a_i − F_i)·∂r_i/∂q_j, torques included
-    extra_V = sum((e for _, e in m.potentials), sp.S.Zero)
-    potential_force = _potential_force(m, extra_V)
-    if potential_force is None:  # which body feels it is not declared: R stays unknown
-        for j, q in enumerate(m.q):  # but its virtual work −∂V/∂q_j is
-            residual[j] += extra_V.diff(q)
+    # a potential V(q) fixes only its force's virtual work, not the force (newton_potentials)
+    unknown = unknown_constraint_forces(m)
+    for j, dV in enumerate(potential_virtual_work(m)):
+        residual[j] += dV
     for b in m.bodies:
         a = m.velocity(b.name).dt(m.N)
         applied = sum((vec for _, kind, vec in acting[b.name] if kind != "torque"), Vector(0))
-        if potential_force is not None:
-            applied += potential_force
         frame = b.natural_frame
         balance_lines.append(
             vec_line(rf"m\vec{{a}}_{{{sub(b.name)}}}", b.mass * a, frame, m, f"m a of {b.name}")
@@ -76,11 +74,11 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
         R = b.mass * a - applied
         for j, q in enumerate(m.q):
             residual[j] += R.dot(b.position.diff(q, m.N))
-        R_solved = sum(
-            (c.xreplace(solved) * u for c, u in _components(R, m.frame(frame))), Vector(0)
-        )
-        R_nice, comps = vec_in(R_solved, frame, m)
-        if potential_force is not None:
+        if unknown is None:
+            R_solved = sum(
+                (c.xreplace(solved) * u for c, u in _components(R, m.frame(frame))), Vector(0)
+            )
+            R_nice, comps = vec_in(R_solved, frame, m)
             support = _support_force(b, R_nice, m)
             name = resultant_name(placed[b.name])
             # a rod's pull is labelled by the rod (the same label on both its ends, opposite
@@ -101,24 +99,8 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
             )
             for j, qd in enumerate(m.qd):
                 residual[j] += (dH - torque).dot(omega.diff(qd, m.N))
-    return _steps(d, balance_lines, forces), forces, [tidy(r, m) for r in residual]
-
-
-def _potential_force(m: Any, V: sp.Expr) -> Vector | None:
-    """−∇V of a given potential, for a scene of one body (the only one it can act on).
-
-    Only its part along the directions the body may move is fixed by V(q):
-    F = −Σ_j c_j ∂r/∂q_j with (JᵀJ) c = ∂V/∂q; any normal part is one with the constraint force.
-    """
-    if V == 0:
-        return Vector(0)
-    if len(m.bodies) != 1:
-        return None
-    r = m.bodies[0].position
-    J = [r.diff(q, m.N) for q in m.q]
-    gram = sp.Matrix(len(J), len(J), lambda i, k: tidy(J[i].dot(J[k]), m))
-    c = gram.LUsolve(sp.Matrix([V.diff(q) for q in m.q]))
-    return sum((-tidy(ci, m) * Ji for ci, Ji in zip(c, J, strict=True)), Vector(0))
+    steps = _steps(d, balance_lines, forces, unknown)
+    return steps, forces, [tidy(r, m) for r in residual]
 
 
 def _support_force(b: Any, R: Vector, m: Any) -> tuple[str, sp.Expr] | None:
@@ -168,7 +150,11 @@ def _components(v: Vector, frame) -> list[tuple[sp.Expr, Vector]]:
     return [(v.dot(u), u) for u in (frame.x, frame.y, frame.z)]
 
 
-def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -> list[Step]:
+def _steps(
+    d: Derivation, balances: list[Line], forces: list[ConstraintForce], unknown: str | None
+) -> list[Step]:
+    """The two steps; ``unknown`` (why the constraint forces are not computed) replaces the
+    promise of the second, so that no step promises a force the response does not carry."""
     m = d.model
     text = (
         "For each particle write Σ F = m a (eq. 10) along the unit vectors of its natural "
@@ -176,6 +162,12 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
         r"$\vec F_C$ named as in the free-body diagram (the rope's or rod's $\vec F_T$, a "
         r"normal force $\vec F_N$) when it is one force there."
     )
+    if m.potentials:
+        text += (
+            " The scene's potentials are not forces on any one body: they enter the balances "
+            r"projected on each $\delta q_j$, as $-\partial V/\partial q_j$, and are not in "
+            r"$\sum \vec F$."
+        )
     constraint_lines = []
     for f in forces:
         lhs = f.label + (" = " + " + ".join(f.parts) if len(f.parts) > 1 else "")
@@ -190,13 +182,17 @@ def _steps(d: Derivation, balances: list[Line], forces: list[ConstraintForce]) -
                     f"F_T_{f.body} = {to_plain(tension)}",
                 )
             )
-    solved_text = (
+    projected = (
         "Projected on the directions the particle may move (∂r/∂q_j) the balances are "
         "the equations of motion — the same as Lagrange's (D'Alembert, eq. 20). "
-        "Projected on the others they give the constraint force, here with q̈ from the "
-        "equations of "
-        "motion: the force the constraint must supply."
     )
+    if unknown is None:
+        solved_text = projected + (
+            "Projected on the others they give the constraint force, here with q̈ from the "
+            "equations of motion: the force the constraint must supply."
+        )
+    else:
+        solved_text = projected + unknown
     return [
         Step("newton", "Newton's method: Σ F = m a", text, balances),
         Step("constraint_forces", "Constraint forces", solved_text, constraint_lines),
@@ -273,4 +269,5 @@ def newton_json(d: Derivation) -> dict[str, Any]:
             name: f"{to_plain(r)} = 0" for name, r in zip(m.coordinate_names, residual, strict=True)
         },
         "agrees_with_lagrange": agrees,
+        "constraint_forces_unknown": unknown_constraint_forces(m),
     }

@@ -872,7 +872,12 @@ def _first(positions: dict, k: int) -> dict:
 
 def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, list[float]]]:
     """R = m a − ΣF along the run; a rod's tension, and where a string would go slack."""
+    from mechanics.newton_potentials import unknown_constraint_forces
+
     out = {}
+    unknown = unknown_constraint_forces(c.derivation.model)
+    if unknown is not None:  # a potential V(q): none is computed, and the run says why
+        warnings.append(unknown)
     for body, (fn, tension_fn) in constraint_force_functions(c).items():
         x, y, z = evaluate(fn, t, q, qd, params)
         out[body] = {"x": x.tolist(), "y": y.tolist(), "z": z.tolist()}
