@@ -21,6 +21,7 @@ from sympy.physics.vector import Vector
 
 from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
+from mechanics.newton_potentials import coordinate_potentials, unknown_constraint_forces
 from mechanics.steps import Line, Step, Work, sub, tidy, vec_line
 from mechanics.steps.energy import letter
 
@@ -608,10 +609,14 @@ def constraint_forces(model: Model) -> tuple[dict[str, list[dict[str, Any]]], li
         elif alone and body.kind == "particle" and not forces[name]:
             note = f"{name}: no constraint acts on it (it moves freely with ${coords}$)"
             if free == 2 and body.position.dot(model.N.z) == 0:
+                across = (  # V(q) says nothing of a push across the plane (newton_potentials)
+                    "whether the scene's potential pushes across it V(q) cannot say"
+                    if coordinate_potentials(model)
+                    else "no force pushes across it, so that constraint's force is zero"
+                )
                 note = (
                     f"{name}: it moves freely in the plane of the motion with ${coords}$; the "
-                    "plane itself (z = 0) is its one constraint, and no force pushes across it, "
-                    "so that constraint's force is zero"
+                    f"plane itself (z = 0) is its one constraint, and {across}"
                 )
         else:
             why = []
@@ -663,6 +668,9 @@ def free_body_diagram(model: Model, work: Work) -> Step:
     """
     acting = body_forces(model)
     placed, notes = constraint_forces(model)
+    unknown = unknown_constraint_forces(model)
+    if unknown is not None:  # drawn where they act, but no size: say so, as /newton does
+        notes = [*notes, unknown]
     lines: list[Line] = []
     drawn = []
     for b in model.bodies:

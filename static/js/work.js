@@ -113,9 +113,12 @@ export function showWork(run, { lecture = false } = {}) {
     ? { x: t, y: f.tension, name: `tension on ${body}`, mode: "lines" }
     : { x: t, y: f.x.map((x, k) => Math.hypot(x, f.y[k], f.z[k])), name: `|F<sub>C</sub>| on ${body}`, mode: "lines" });
   const tension = Object.values(forces).some((f) => f.tension);
-  const constraintTitle = tension
-    ? "constraint forces (tension < 0: a string goes slack)"
-    : "constraint forces |F<sub>C</sub>| along the run";
+  // none at all: a potential V(q) left them unknown (the run's warnings and the FBD say why)
+  const constraintTitle = !ctraces.length
+    ? "constraint forces: not computed (see the warnings)"
+    : tension
+      ? "constraint forces (tension < 0: a string goes slack)"
+      : "constraint forces |F<sub>C</sub>| along the run";
   $("plot-constraint").dataset.tension = tension ? "1" : "0";
   window.Plotly.react("plot-constraint", ctraces, { ...base, margin: top(constraintTitle), title: title(constraintTitle),
     xaxis: { title: { text: "t (s)" }, automargin: true }, yaxis: { title: { text: "N" }, zeroline: true } }, CONFIG);
