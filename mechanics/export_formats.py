@@ -133,7 +133,7 @@ def trajectory_csv(
     columns = trajectory_columns(run, units)
     out = io.StringIO()
     for line in comments:
-        out.write("# " + one_line(line) + "\n")
+        out.write("# " + defused(one_line(line)) + "\n")
     out.write(",".join(_header_cell(name, unit) for name, unit in columns) + "\n")
     series = [_series(run, name) for name, _ in columns]
     for row in zip(*series, strict=True):
@@ -153,6 +153,29 @@ def one_line(text: str) -> str:
     """``text`` with each line break (`LINE_BREAKS`, U+2028 and U+0085 too) as a space: a comment
     that a title or a stop message split would start a data row in the middle of the header."""
     return "".join(" " if ch in LINE_BREAKS else ch for ch in text)
+
+
+#: What makes a spreadsheet (Excel, LibreOffice, Google Sheets) read a cell as a formula: a title
+#: or a stop message is someone's text, and ``x,=HYPERLINK("http://…")`` in it would be a cell
+#: that runs when the CSV is opened (OWASP "CSV injection").
+FORMULA_START = frozenset("=+-@\t\r")
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|nan)", re.IGNORECASE)
+
+
+def defused(text: str) -> str:
+    """``text`` with each of its comma-separated cells that a spreadsheet would run as a formula
+    prefixed with ``'`` (the spreadsheets' own mark for "this is text"); a number such as -1.5
+    is left as it is, and so is every other cell. A cell's leading spaces and opening quote are
+    looked through: ``"=1+1"`` is the cell =1+1 to a CSV reader."""
+    return ",".join(_defused_cell(cell) for cell in text.split(","))
+
+
+def _defused_cell(cell: str) -> str:
+    start = len(cell) - len(cell.lstrip(' "'))
+    rest = cell[start:]
+    if rest[:1] in FORMULA_START and not _NUMBER.fullmatch(rest.strip().strip('"')):
+        return cell[:start] + "'" + rest
+    return cell
 
 
 def stats_lines(stats: Mapping[str, Any], prefix: str = "stats.") -> list[str]:
