@@ -24,6 +24,13 @@ from sympy.simplify.fu import TR5
 
 from mechanics import units
 from mechanics.answers import read_answer
+from mechanics.check_identities import (  # noqa: F401  (re-exported: the proofs' budget)
+    MAX_NORMAL_TERMS,
+    MAX_TRIG_MULTIPLE,
+    PROOF_OPS,
+    zero_by_algebra,
+)
+from mechanics.check_identities import expansion_size as _expansion_size
 from mechanics.derive import Derivation
 from mechanics.expr import parse
 from mechanics.expr import to_latex as _latex_of
@@ -37,23 +44,15 @@ SAMPLES = 12
 MAX_UNIT_LINES = 4
 MAX_TERMS = 40  # past this many monomials, feedback term by term would not help anyone
 TOLERANCE = 1e-9
-#: No proof is tried past this size (count_ops of the difference): a hostile answer that the
-#: samples cannot tell from the derived one is then "not confirmed", never held for minutes.
-PROOF_OPS = 400
 #: Past PROOF_OPS, up to this size, only the evaluation at exact random points is tried (a
 #: solved q̈ of the double pendulum, typed out expanded, is 533 operations).
 MAX_PROOF_OPS = 4000
-#: A normal form (expanded) is tried only up to this many terms of expansion ((sin θ + cos θ)⁶⁰
-#: is 61 terms, and 15 s of trig passes); past it, exact evaluation decides alone.
-MAX_NORMAL_TERMS = 40
 #: No proof past this exponent: exact rationals to the 10⁴th power are megabytes of digits.
 MAX_PROOF_POWER = 256
 #: sympy's general simplify() is the last resort, and only this small (it is the slow one).
 SIMPLIFY_OPS = 60
 #: |·| and sign() are settled by trying both signs of their argument: 2**k cases for k of them.
 MAX_SIGN_CASES = 3
-#: expand_trig of sin(n θ) is a polynomial of degree n: past this n the trig stays opaque.
-MAX_TRIG_MULTIPLE = 8
 #: A number typed within this relative distance of a simple one (a fraction with a denominator
 #: up to NEAR_MISS_DENOMINATOR) is a near miss of it: 1.9999999999 of 2, 0.49999999999 of 1/2.
 NEAR_MISS = 1e-6
@@ -132,32 +131,6 @@ class Verdict:
         return out
 
 
-def _expansion_size(expr: sp.Expr, cap: int) -> int:
-    """An upper estimate of how many terms expanding ``expr`` (products, integer powers of sums,
-    trig of sums) gives, saturating past ``cap``: decided from the tree, without expanding."""
-    if expr.is_Atom:
-        return 1
-    if isinstance(expr, sp.Add):
-        return min(cap + 1, sum(_expansion_size(a, cap) for a in expr.args))
-    if isinstance(expr, sp.Mul):
-        size = 1
-        for a in expr.args:
-            size = min(cap + 1, size * _expansion_size(a, cap))
-        return size
-    if isinstance(expr, sp.Pow):
-        n = expr.exp
-        if not (n.is_Integer and n > 1):
-            return 1  # (a + b)⁻² or √(a + b) stays one term
-        k = _expansion_size(expr.base, cap)
-        return 1 if k == 1 else min(cap + 1, math.comb(int(min(n, 10**4)) + k - 1, k - 1))
-    if isinstance(expr, sp.Function):
-        k = max((_expansion_size(a, cap) for a in expr.args), default=1)
-        if k == 1:
-            return 1  # sin θ stays one term (sin²θ + cos²θ to the 16th is 17 terms, not 20349)
-        return min(cap + 1, 2 ** min(k, 20))  # sin(a + b + …) expands into products
-    return 1
-
-
 def _huge_multiple(expr: sp.Expr) -> bool:
     """Does ``expr`` hold sin(n θ) (or cos, tan, ...) with an integer n past
     MAX_CANONICAL_MULTIPLE? Expanding it is a Chebyshev polynomial of degree n: never for 10¹⁴."""
@@ -199,7 +172,7 @@ def zero_proof(expr: sp.Expr, model: Any) -> bool | None:
     cases = _sign_cases(e, _positive_in_domain(model))
     if cases is None:
         return None
-    results = [_zero_by_algebra(c, small) for c in cases]
+    results = [zero_by_algebra(c, small) for c in cases]
     if all(r is True for r in results):
         return True
     if len(cases) == 1 and results[0] is False:
@@ -283,92 +256,6 @@ def _sign_cases(e: sp.Expr, positive: tuple[sp.Expr, ...] = ()) -> list[sp.Expr]
 def _max_power(e: sp.Expr) -> int:
     """The largest integer exponent in ``e`` (a tower (θ⁶⁴)⁶⁴ counts as written, 64)."""
     return max((abs(int(p.exp)) for p in e.atoms(sp.Pow) if p.exp.is_Integer), default=0)
-
-
-def _zero_by_algebra(e: sp.Expr, normal_form: bool = True) -> bool | None:
-    """zero_proof's exact argument for a rational function of sin, cos and the symbols: its
-    normal form when ``normal_form`` (small), else exact evaluation at random points."""
-    e = e.replace(sp.tan, lambda a: sp.sin(a) / sp.cos(a))
-    e = e.replace(sp.cot, lambda a: sp.cos(a) / sp.sin(a))
-    e = e.replace(sp.sec, lambda a: 1 / sp.cos(a))
-    e = e.replace(sp.csc, lambda a: 1 / sp.sin(a))
-    for f in e.atoms(sp.sin, sp.cos):
-        coefficients = sp.Add.make_args(f.args[0])
-        for term in coefficients:
-            number = term.as_coeff_Mul()[0]
-            if not number.is_Integer or abs(number) > MAX_TRIG_MULTIPLE:
-                return None  # sin(θ/2), sin(100 θ): no short polynomial in sin θ, cos θ
-    e = sp.expand_trig(e)
-    pairs: dict[sp.Expr, tuple[sp.Symbol, sp.Symbol]] = {}
-    opaque = False  # sin(w t): still on the circle, but not shown independent of the rest
-    for f in sorted(e.atoms(sp.sin, sp.cos), key=sp.default_sort_key):
-        a = f.args[0]
-        if a.is_number:
-            continue  # cos 1: a number
-        opaque = opaque or not a.is_Symbol
-        pairs.setdefault(a, (sp.Dummy("s", real=True), sp.Dummy("c", real=True)))
-    e = e.xreplace(
-        {k: v for a, (s, c) in pairs.items() for k, v in ((sp.sin(a), s), (sp.cos(a), c))}
-    )
-    if not e.is_rational_function(*e.free_symbols):
-        return None  # exp, log, a square root of a variable, ...
-    if (
-        not normal_form
-        or sp.count_ops(e) > PROOF_OPS
-        or _expansion_size(e, MAX_NORMAL_TERMS) > MAX_NORMAL_TERMS  # sin 8θ is 5 terms now
-    ):
-        zero = _zero_at_random_points(e, pairs)
-    else:
-        numerator, denominator = sp.fraction(sp.together(e))
-        if _reduce_circle(denominator, pairs) == 0:
-            return None  # no value anywhere: not an identity to speak of
-        zero = _reduce_circle(numerator, pairs) == 0
-    # zero with sin(w t), cos(w t) as free points on the circle is zero; non-zero is only
-    # non-zero if nothing ties sin(w t) to the rest (cos(2 w t) would): claimed no further
-    return None if zero is False and opaque else zero
-
-
-def _zero_at_random_points(e: sp.Expr, pairs: dict) -> bool | None:
-    """A rational function too big to bring to normal form, evaluated exactly (rational
-    arithmetic, no rounding) at random rational points, sin and cos of each coordinate on the
-    unit circle ((1 − u²)/(1 + u²), 2u/(1 + u²)). A non-zero value is an exact certificate that
-    it is not zero; zero at every point means it is zero but for a chance below
-    degree/2⁴⁸ per point (Schwartz–Zippel): a rational function has no narrow bumps to hide in.
-    """
-    rng = random.Random(2)
-    circle = {s for pair in pairs.values() for s in pair}
-    symbols = sorted(e.free_symbols - circle, key=sp.default_sort_key)
-    zeros = 0
-    for _ in range(4):
-        point: dict[sp.Expr, sp.Expr] = {
-            x: sp.Rational(rng.randrange(1, 2**48), rng.randrange(1, 2**16)) for x in symbols
-        }
-        for s, c in pairs.values():
-            u = sp.Rational(rng.randrange(1, 2**48), 2**48)
-            point[s], point[c] = 2 * u / (1 + u**2), (1 - u**2) / (1 + u**2)
-        try:
-            value = e.xreplace(point)
-        except ZeroDivisionError:
-            continue
-        if not value.is_Rational:
-            continue  # a pole (zoo, nan) at this point: no number there
-        if value != 0:
-            return False
-        zeros += 1
-    return True if zeros >= 2 else None
-
-
-def _reduce_circle(p: sp.Expr, pairs: dict) -> sp.Expr:
-    """p with every sin² written 1 − cos²: the normal form modulo sin² + cos² = 1."""
-    p = sp.expand(p)
-    for s, c in pairs.values():
-        p = sp.expand(
-            p.replace(
-                lambda x, s=s: x.is_Pow and x.base == s and x.exp.is_Integer and x.exp > 1,
-                lambda x, s=s, c=c: s ** (x.exp % 2) * (1 - c**2) ** (x.exp // 2),
-            )
-        )
-    return p
 
 
 def expected_quantity(d: Derivation, quantity: str, j: int | None) -> sp.Expr:
