@@ -36,6 +36,8 @@ def fresh_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.delenv(cache.REDIS_ENV_VAR, raising=False)
     monkeypatch.setitem(cache._redis_state, "down_until", 0.0)
     monkeypatch.setitem(cache._redis_state, "logged", False)
+    monkeypatch.setitem(cache._disk_state, "down_until", 0.0)
+    monkeypatch.setitem(cache._disk_state, "logged", False)
     return tmp_path
 
 
@@ -340,7 +342,7 @@ def test_when_the_computer_in_another_process_fails_the_waiter_computes(tmp_path
 
 def test_the_disk_store_stays_bounded(monkeypatch):
     monkeypatch.setenv(cache.SIZE_ENV_VAR, "0.01")  # ~10 kB
-    monkeypatch.setattr(cache._DiskBackend, "PRUNE_EVERY", 1)
+    monkeypatch.setattr(cache.DiskBackend, "PRUNE_EVERY", 1)
     for i in range(40):
         cache.get_or_compute("check", {"i": i}, lambda i=i: {"feedback": "x" * 1000, "i": i})
     folder = cache.cache_dir() / "check"
@@ -352,7 +354,7 @@ def test_the_disk_store_stays_bounded(monkeypatch):
 
 def test_without_redis_values_are_computed_and_kept_on_disk_logged_once(monkeypatch, caplog):
     monkeypatch.setenv(cache.REDIS_ENV_VAR, f"redis://127.0.0.1:{free_port()}/0")
-    monkeypatch.setattr(cache, "REDIS_RETRY_SECONDS", 0.0)  # try Redis on every call
+    monkeypatch.setattr(cache.cache_redis, "RETRY_SECONDS", 0.0)  # try Redis on every call
     with caplog.at_level(logging.WARNING, logger="mechanics.cache"):
         for i in range(3):
             assert cache.get_or_compute("newton", {"i": i}, lambda i=i: {"i": i}) == {"i": i}

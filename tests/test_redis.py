@@ -93,6 +93,7 @@ def shared(redis_url: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> s
     monkeypatch.setenv(cache.ENV_VAR, str(tmp_path / "disk"))
     monkeypatch.setitem(cache._redis_state, "down_until", 0.0)
     monkeypatch.setitem(cache._redis_state, "logged", False)
+    monkeypatch.setitem(cache._disk_state, "down_until", 0.0)
     return redis_url
 
 
@@ -106,6 +107,7 @@ def rkey(store: str, parts: object, suffix: str = "") -> str:
 def test_an_entry_lives_in_redis_with_its_store_ttl_not_on_disk(shared, client, tmp_path):
     parts = {"spec": "ttl", "n": time.time()}
     assert cache.get_or_compute("equilibria", parts, lambda: {"x": 1}) == {"x": 1}
+    assert cache.flush()  # writes leave the request's path: a background thread does them
     ttl = client.pttl(rkey("equilibria", parts))
     assert 0 < ttl <= cache.STORES["equilibria"].ttl_seconds * 1000
     assert client.exists(rkey("equilibria", parts, ":lock")) == 0  # released
@@ -115,12 +117,14 @@ def test_an_entry_lives_in_redis_with_its_store_ttl_not_on_disk(shared, client, 
 def test_a_tampered_redis_entry_is_recomputed_never_served(shared, client):
     parts = {"spec": "tampered", "n": time.time()}
     cache.get_or_compute("newton", parts, lambda: {"tension": "good"})
+    assert cache.flush()
     key = rkey("newton", parts)
     client.set(key, client.get(key)[:-3])  # truncated
     cache._memories.clear()
     assert cache.get_or_compute("newton", parts, lambda: {"tension": "again"}) == {
         "tension": "again"
     }
+    assert cache.flush()
     cache._memories.clear()
     assert cache.get("newton", parts) == {"tension": "again"}
 
@@ -150,7 +154,7 @@ def test_processes_with_separate_disks_share_one_computation(shared, tmp_path):
         for i in range(4)
     ]
     answers = [json.loads(p.communicate(timeout=60)[0]) for p in procs]
-    assert len({a["by"] for a in answers}) == 1
+    assert len({a["by"] for a in answers}) == 1  # the computer's writes are flushed at its exit
     assert cache.shared_computations("equilibria") == before + 1
 
 
@@ -171,12 +175,13 @@ def test_when_redis_goes_away_values_are_computed_and_kept_on_disk(tmp_path, mon
     monkeypatch.setenv(cache.ENV_VAR, str(tmp_path / "disk"))
     monkeypatch.setitem(cache._redis_state, "down_until", 0.0)
     monkeypatch.setitem(cache._redis_state, "logged", False)
-    monkeypatch.setattr(cache, "REDIS_RETRY_SECONDS", 0.0)  # try Redis on every call
+    monkeypatch.setattr(cache.cache_redis, "RETRY_SECONDS", 0.0)  # probe Redis at every call
     assert cache.get_or_compute("newton", {"away": 0}, lambda: {"i": 0}) == {"i": 0}
     stop(proc)
     with caplog.at_level(logging.WARNING, logger="mechanics.cache"):
         for i in range(1, 4):
             assert cache.get_or_compute("newton", {"away": i}, lambda i=i: {"i": i}) == {"i": i}
+            assert cache.flush()
     assert len([r for r in caplog.records if "Redis is unreachable" in r.message]) == 1
     assert len(list((tmp_path / "disk" / "newton").glob("*.entry"))) == 3
 
