@@ -310,7 +310,11 @@ def sample_times():
 
 
 def main():
-    parser = argparse.ArgumentParser(description="Integrate " + TITLE)
+    # argparse %-formats a description that contains "%(prog)": the title's own % are doubled
+    # and "%(prog).0s" (the program's name, zero characters of it) makes that always happen,
+    # so the help prints the title as written, whatever % it holds.
+    description = "Integrate " + TITLE.replace("%", "%%") + "%(prog).0s"
+    parser = argparse.ArgumentParser(description=description)
     parser.add_argument("--json", help="write t, q and q_dot as JSON to this file")
     parser.add_argument("--csv", help="write t, q and q_dot as CSV to this file")
     args = parser.parse_args()

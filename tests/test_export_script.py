@@ -214,3 +214,23 @@ def test_script_errors_name_the_field():
     assert r.json()["detail"] == [
         {"field": "theta", "message": "must be a finite number, not 'nan'"}
     ]
+
+
+@pytest.mark.parametrize("title", ["%(x)s", "100% %(prog)s", "%(prog)s %(x)s", "50 %", "%%"])
+def test_a_title_with_percent_signs_keeps_the_scripts_help_working(title, tmp_path):
+    """argparse %-formats a description holding "%(prog)": a posted title "%(prog)s %(x)s" made
+    the exported script's --help raise KeyError (issue 24, item 6). The help prints the title
+    as written."""
+    from mechanics.scenes import load_scene
+
+    scene = load_scene("simple_pendulum")
+    scene["title"] = title
+    r = client.post("/api/v1/export/script", json={"scene": scene, "t_end": 1})
+    assert r.status_code == 200, r.text
+    path = tmp_path / "run.py"
+    path.write_text(r.text)
+    done = subprocess.run(
+        [sys.executable, str(path), "--help"], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert f"Integrate {title}" in " ".join(done.stdout.split())
