@@ -24,6 +24,7 @@ verdict are one procedure whose parts only make sense together.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import itertools
 import math
@@ -38,6 +39,9 @@ import numpy as np
 import sympy as sp
 from sympy.physics.vector import Vector
 
+from mechanics import equilibrium_families as families_
+from mechanics import equilibrium_flat as flat
+from mechanics import equilibrium_stability as stability
 from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
 from mechanics.expr import parse, to_latex, to_plain
@@ -96,6 +100,8 @@ class Verdict:
     family: str = ""
     #: q0 is a pole of the coordinates: they cannot move in every direction there.
     pole: bool = False
+    #: Directions of a family of equilibria through q0 that the higher-order test found.
+    family_dim: int = 0
 
     @property
     def stable(self) -> bool:
@@ -180,18 +186,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     # one sentence per reason, over every side of the springs' anchors
     warnings += [_numeric_note(why, roots) for why, roots in numeric_only.items()]
     found.sort(key=lambda vr: [abs(vr[1].numeric.get(j, 0.0)) for j in range(len(m.q))])
-    if len(found) > MAX_EQUILIBRIA:
-        warnings.append(
-            f"More than {MAX_EQUILIBRIA} equilibria"
-            + (" (a continuum?)" if _crowded([r.numeric for _, r in found], periods) else "")
-            + f": only the first {MAX_EQUILIBRIA} are listed."
-        )
-        found = found[:MAX_EQUILIBRIA]
+    crowded = _crowded([r.numeric for _, r in found], periods)
     free = sorted({j for j, c in enumerate(conditions) if c == 0} | set(idle))
     results, verdicts = [], []
     left_out = False  # balanced where the system has no state: "never balance" would be false
+    continua = families_.Continua(m, values)
     for variant, root in found:
         q0 = [root.numeric.get(j, inside.get(j, 0.0)) for j in range(len(m.q))]
+        if continua.member(q0) or len(results) > MAX_EQUILIBRIA:
+            continue  # a family's member is said once; past the list's length, not judged
         where = _undefined_position(m, q0, values)
         if where is not None:
             warnings.append(
@@ -241,21 +244,37 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             continue
         if verdict.pole and not _held_at_pole(d, variant, q0, values):
             warnings.append(
-                f"Every ${letter(m, 'Q')}_j$ vanishes at {_point_text(m, q0)}, a pole "
-                "of the coordinates, only "
-                "because they cannot move in every direction there: beside it the forces do not "
-                "shrink to 0 (a force or torque acts along a direction they lose there), so it is "
-                "not an equilibrium and is left out."
+                f"Every ${letter(m, 'Q')}_j$ vanishes at {_point_text(m, q0)}, a "
+                + (
+                    "singular point of the coordinates (no coordinate carries inertia there), "
+                    "only because the position does not move to first order in them: beside "
+                    "it the force along the path does not shrink to 0 (at a cusp of the wire "
+                    "gravity pulls along it)"
+                    if verdict.reason.startswith(flat.SINGULAR)
+                    else "pole of the coordinates, only because they cannot move in every "
+                    "direction there: beside it the forces do not shrink to 0 (a force or "
+                    "torque acts along a direction they lose there)"
+                )
+                + ", so it is not an equilibrium and is left out."
             )
             continue
-        verdict.family = root.family
+        verdict.family = root.family or verdict.family
         verdicts.append(verdict)
         results.append(_result_json(m, root, free, verdict, q0))
+        continua.add(q0, verdict, results[-1])
     order = sorted(range(len(results)), key=lambda i: [abs(v) for v in results[i]["q"].values()])
     results, verdicts = [results[i] for i in order], [verdicts[i] for i in order]
     results, verdicts = _one_per_configuration(m, results, verdicts, values, warnings)
     results, verdicts = _inside_the_model(m, results, verdicts, values, warnings)
     results, verdicts = _where_the_stops_allow(d, results, verdicts, values, warnings)
+    continua.describe(results, verdicts)
+    if len(results) > MAX_EQUILIBRIA:
+        warnings.append(
+            f"More than {MAX_EQUILIBRIA} equilibria"
+            + (" (a continuum?)" if crowded and not continua.groups else "")
+            + f": only the first {MAX_EQUILIBRIA} are listed."
+        )
+        results, verdicts = results[:MAX_EQUILIBRIA], verdicts[:MAX_EQUILIBRIA]
     families += [v.family for v in verdicts if v.family and v.family not in families]
     steps.append(_stability_step(m, results, verdicts))
     dry = _once(d, "dry friction", "", lambda: _dry_friction(d))
@@ -1971,8 +1990,10 @@ def _stability(
     # absolute 1e-12 took m = 1e-13 for no inertia at all, and every equilibrium for stable.
     inertia = float(np.max(np.abs(np.diag(full_M)), initial=0.0))
     idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12 * inertia]
-    if not idx:
-        return Verdict("stable", "no coordinate carries inertia here", [], [], [], [], None)
+    if not idx:  # the coordinates are singular here (∂r/∂q = 0), the body is not weightless
+        forces = _rest_force_function(*(tuple(x) for x in (v.forcing, m.q, m.qd, m.qdd)), psyms)
+        kind, reason = flat.singular_point(at_rest, forces, q0, numbers if at_rest else [])
+        return Verdict(kind, reason, [], [], [], [], None, pole=True)
     if at_rest is not None and _singular(full_M[np.ix_(idx, idx)], 1e-12):
         idx = _off_the_pole(at_rest, full_M, q0, numbers, idx)
     K = K_.reshape(n, n)[np.ix_(idx, idx)]
@@ -1983,12 +2004,22 @@ def _stability(
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
     n_free = len([j for j in free if j in idx]) + family_dim
     names = [m.coordinate_names[j] for j in idx]
+    keep = [k for k, j in enumerate(idx) if j not in free]
+    report = None  # the flat directions of K, judged by the higher-order test
+    if at_rest is not None and not family_dim and power.kind != "no sign":
+        forces = _rest_force_function(*(tuple(x) for x in (v.forcing, m.q, m.qd, m.qdd)), psyms)
+        report = flat.flat_at(at_rest, forces, q0, numbers, idx, keep, M, C, K)
+    n_free += report.level if report else 0
     kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m), power=power)
+    shown, latex_names = _eigen_math(lam), [to_latex(m.q[j]) for j in idx]
+    single, potential = len(keep) == 1, _potential(_turning(m))
+    kind, reason = flat.amend(kind, reason, report, latex_names, shown, single, potential)
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
     vectors = [vecs[: len(idx), i] for i in range(len(lam))]
     verdict = Verdict(kind, reason, list(lam), freqs, modes, phases, linear, vectors)
+    verdict.family_dim = report.level if report else 0
     lost = [j for j in range(n) if j not in idx]
     if lost and at_rest is not None and _turns_beside(at_rest, full_M, q0, numbers, idx, lost):
         # Coriolis (or a magnetic force) couples the radial motion to the turn about the pole
@@ -2377,10 +2408,13 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
     n = len(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
     lam, vecs = np.linalg.eig(A)
+    if not np.any(C) and np.max(np.abs(K - K.T), initial=0.0) <= 1e-9 * np.max(np.abs(K)):
+        with contextlib.suppress(np.linalg.LinAlgError, ValueError):  # M not definite: eig's
+            lam, vecs = stability.conservative_eigenvalues(M, K)
     order = _eigen_order(lam)
     lam, vecs = lam[order], vecs[:, order]
     scale = max(1.0, float(np.max(np.abs(lam))))
-    tol = 1e-7 * scale
+    tol = stability.growth_tolerance(A, lam, np.linalg.solve(M, K))
     k_shown = np.linalg.eigvalsh((K + K.T) / 2)  # what the sentences quote: K as displayed
     # The tests below judge K and C per unit of inertia (L⁻¹ K L⁻ᵀ with M = L Lᵀ: eigenvalues
     # ω² in 1/s²), so that no choice of mass or length unit moves them across a tolerance: with
@@ -2415,7 +2449,7 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
                 "minimum here"
             )
         return "unstable", reason, lam, vecs
-    zero = np.abs(lam) <= 1e-6 * scale
+    zero = np.abs(lam) <= max(1e-6 * scale, tol)
     if n_free == n:
         # what a nudge does without a restoring force depends on the velocity-linear terms
         if gyroscopic:
