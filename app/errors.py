@@ -92,6 +92,66 @@ def unreadable_body(cause: BaseException | None) -> str:
     return "invalid JSON: it cannot be read"
 
 
+#: A UTF-16 surrogate code point: JSON's ``\\ud800`` escape decodes to one when it is not half of
+#: a pair, and such a string is not text (it cannot be written as UTF-8: orjson, hashing for the
+#: cache and every answer that quotes it failed on it with a 500).
+_SURROGATE = re.compile("[\ud800-\udfff]")
+LONE_SURROGATE = (
+    "holds a lone UTF-16 surrogate ({code}), which is not a character: "
+    "send the whole character (both halves of a surrogate pair) or leave it out"
+)
+
+
+async def refuse_lone_surrogates(request: Request) -> None:
+    """A JSON body with a lone surrogate in any key or string is a 422 naming the first such
+    field, before any route or model sees it (hostile play-test, issue 24: ``{"parameters":
+    {"\\ud800": 1}}`` was a 500 on six routes). Installed as the app's one global dependency, it
+    runs after FastAPI has read and parsed the body, so the body is neither read nor parsed twice;
+    a body without a ``\\ud``/``\\uD`` escape cannot hold one and is not walked."""
+    if request.method not in ("POST", "PUT", "PATCH"):
+        return
+    body = await request.body()
+    if b"\\ud" not in body and b"\\uD" not in body:
+        return
+    try:
+        document = await request.json()
+    except ValueError:
+        return  # not JSON: FastAPI has answered it already, or the route does not read JSON
+    found = lone_surrogate_at(document)
+    if found is not None:
+        path, code = found
+        if path[:1] == ["scene"] and len(path) > 1:
+            path = path[1:]  # inside a posted scene, fields are the spec's own paths
+        field = field_path(path) or "body"
+        raise HTTPException(422, [{"field": field, "message": LONE_SURROGATE.format(code=code)}])
+
+
+def lone_surrogate_at(document: Any) -> tuple[list[Any], str] | None:
+    """(path, the surrogate as ``\\udxxx``) of the first key or string in ``document`` that holds
+    a lone surrogate, else None; a key is named with its surrogates written as escapes. Walked
+    with a stack: a JSON document may nest deeper than Python's recursion limit allows."""
+    stack: list[tuple[list[Any], Any]] = [([], document)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, str):
+            match = _SURROGATE.search(value)
+            if match:
+                return path, _escaped(match.group())
+        elif isinstance(value, dict):
+            for key, item in reversed(value.items()):
+                match = _SURROGATE.search(key)
+                if match:
+                    return [*path, _escaped(key)], _escaped(match.group())
+                stack.append(([*path, key], item))
+        elif isinstance(value, list):
+            stack.extend(([*path, i], item) for i, item in reversed(list(enumerate(value))))
+    return None
+
+
+def _escaped(text: str) -> str:
+    return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 #: Said after an unknown scene_id, whichever route raised it (/derive, /check, live.js, …).
 WHERE_SCENE_IDS = " (GET /api/v1/scenes lists the scene ids)"
 

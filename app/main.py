@@ -6,14 +6,14 @@ becomes its HTTP answer in app/errors.py.
 
 from __future__ import annotations
 
-from fastapi import FastAPI, Request
+from fastapi import Depends, FastAPI, Request
 from starlette.middleware.gzip import GZipMiddleware
 from starlette.types import ASGIApp
 
 from app import __version__
 from app.assets import Assets, content_version, package_version
 from app.derivations import pool_lifespan
-from app.errors import register_error_handlers
+from app.errors import refuse_lone_surrogates, register_error_handlers
 from app.middleware import BodyLimit, HeadAsGet, OneValuePerKey, SecurityHeaders
 from app.paths import STATIC_DIR, api_docs_dir, mathjax_dir, plotly_dir
 from app.responses import ORJSONResponse
@@ -55,6 +55,8 @@ app = LagrangeLab(
     summary="Step-by-step Lagrangian mechanics: from a scene to its equations of motion.",
     docs_url=None,  # served by app/routes/pages.py with Swagger UI's files from this app
     redoc_url=None,
+    # a lone surrogate anywhere in a JSON body: a 422 naming its field, before any route runs
+    dependencies=[Depends(refuse_lone_surrogates)],
 )
 app.include_router(scenes.router)
 app.include_router(derive.router)
