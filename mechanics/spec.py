@@ -190,9 +190,13 @@ class SceneSpec(_Model):
     summary: Text = ""
     coordinates: Annotated[list[Ident], Field(min_length=1, max_length=MAX_COORDINATES)]
     #: Coordinates that never go negative (a radius): lets sqrt(r**2) print as r, not |r|.
-    positive_coordinates: list[Ident] = []
+    positive_coordinates: Annotated[list[Ident], Field(max_length=MAX_COORDINATES)] = []
     parameters: Annotated[dict[Ident, Number], Field(max_length=MAX_PARAMETERS)] = {}
-    units: dict[Ident, Annotated[str, StringConstraints(max_length=40)]] = {}
+    #: a unit per parameter or coordinate at most (a 439 kB map was a 2.3 MB error)
+    units: Annotated[
+        dict[Ident, Annotated[str, StringConstraints(max_length=40)]],
+        Field(max_length=MAX_PARAMETERS + MAX_COORDINATES),
+    ] = {}
     frames: _items(Frame) = []
     points: _items(PointSpec) = []
     bodies: Annotated[list[Body], Field(min_length=1, max_length=MAX_BODIES)]
