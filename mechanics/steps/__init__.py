@@ -16,6 +16,7 @@ from sympy.physics.vector import Vector
 from sympy.simplify.fu import TR5, TR6, TR8, TR10i
 
 from mechanics.expr import to_latex, to_plain
+from mechanics.steps.radicals import radicals, tidy_radical
 
 #: Expressions larger than this (count_ops) skip trigsimp: it is the step that can take minutes.
 SIMPLIFY_OPS_BUDGET = 600
@@ -151,6 +152,9 @@ Tidied = tuple[sp.Expr, tuple[sp.Expr, ...]]
 def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -> Tidied:
     """tidy() on plain symbols. Cached across derivations, so it returns the pieces it left
     unsimplified instead of reporting them: a cache hit must flag exactly what a miss flags."""
+    roots = radicals(expr)
+    if roots:  # roots or quotients of sums: see steps/radicals.py
+        return tidy_radical(expr, roots, velocities, _trig_pass, _size, factor_whole)
     e = sp.expand(expr)
     if e == 0:
         return e, ()

@@ -8,6 +8,7 @@ from mechanics.expr import to_latex, to_plain
 from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, d_dt, eq_line, partial, tidy
 from mechanics.steps.energy import letter, script_note
+from mechanics.steps.radicals import held
 
 
 def lagrange_equations(model: Model, work: Work) -> Step:
@@ -56,6 +57,11 @@ def lagrange_equations(model: Model, work: Work) -> Step:
 
 
 def ratio(num: sp.Expr, den: sp.Expr, model: Model) -> sp.Expr:
-    """num/den with common polynomial factors cancelled and each side tidied separately."""
-    n, d = sp.fraction(sp.cancel(sp.factor_terms(num) / sp.factor_terms(den)))
+    """num/den with common polynomial factors cancelled and each side tidied separately.
+
+    Roots of sums (a gravitational potential's) are held as symbols while cancelling: cancel()
+    on the roots themselves puts every term over one denominator and took seconds."""
+    to, back = held([num, den])
+    quotient = sp.factor_terms(num.xreplace(to)) / sp.factor_terms(den.xreplace(to))
+    n, d = (x.xreplace(back) for x in sp.fraction(sp.cancel(quotient)))
     return tidy(n, model) / sp.factor(tidy(d, model))

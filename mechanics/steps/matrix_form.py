@@ -9,6 +9,7 @@ from mechanics.model import Model
 from mechanics.steps import Line, Step, Work, eq_line, partial, tidy
 from mechanics.steps.energy import letter
 from mechanics.steps.lagrange import ratio
+from mechanics.steps.radicals import held
 
 #: q̈ is solved symbolically for at most this many coordinates ...
 SOLVE_MAX_COORDINATES = 3
@@ -62,7 +63,10 @@ def mass_matrix_form(model: Model, work: Work) -> Step:
 
 
 def determinant(M: sp.Matrix, model: Model) -> sp.Expr:
-    return tidy(M.det(method="berkowitz"), model, collect_velocities=False)
+    to, back = held(list(M))  # roots of sums as symbols: det() would simplify inside them
+    return tidy(
+        M.xreplace(to).det(method="berkowitz").xreplace(back), model, collect_velocities=False
+    )
 
 
 def definiteness(det: sp.Expr | None, model: Model, listed: bool) -> str:
@@ -97,9 +101,10 @@ def solve_accelerations(M: sp.Matrix, f: sp.Matrix, model: Model, det: sp.Expr) 
     n = M.shape[0]
     if n == 1:
         return [ratio(f[0], M[0, 0], model)]
+    to, back = held([*M, *f])  # roots of sums as symbols: det() would simplify inside them
     out = []
     for i in range(n):
-        Mi = M.copy()
-        Mi[:, i] = f
-        out.append(ratio(Mi.det(method="berkowitz"), det, model))
+        Mi = M.xreplace(to)
+        Mi[:, i] = f.xreplace(to)
+        out.append(ratio(Mi.det(method="berkowitz").xreplace(back), det, model))
     return out
