@@ -21,6 +21,7 @@ from pydantic import (
     field_validator,
 )
 
+from mechanics.constant_mass import variable_mass_errors
 from mechanics.units import BASE, UnitError, parse_unit
 
 #: Budgets on a posted spec: a spec past them is refused before any algebra runs.
@@ -370,6 +371,7 @@ def check_names(spec: SceneSpec) -> None:
     for i, b in enumerate(spec.bodies):
         if isinstance(b.mass, (int, float)) and b.mass <= 0:
             err(f"bodies[{i}].mass", "must be > 0: a body needs a positive mass")
+    errors += variable_mass_errors(spec)  # Lagrange's equations need constant masses
     allowed_initial = set(spec.coordinates) | {f"{q}_dot" for q in spec.coordinates}
     for name in spec.initial:
         if name not in allowed_initial:
