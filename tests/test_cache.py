@@ -474,3 +474,25 @@ def test_a_source_that_is_not_generated_is_refused(find, replace):
     source = native.rhs_source(args, 1, sp.S.Zero, accelerations=[-sp.sin(args[1])])
     assert native.is_generated_source(source) and find in source
     assert not native.is_generated_source(source.replace(find, replace, 1))
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        b"",  # a writer that died (or whose disk filled) between creating the file and writing it
+        b'{"token": "half',  # cut short
+        json.dumps({"token": "t", "host": "elsewhere", "pid": 1, "until": 1.0}).encode(),
+    ],
+    ids=["empty", "cut short", "past its deadline"],
+)
+def test_a_stale_lock_is_recognised_at_once(body, monkeypatch):
+    """Issue 24 (item 2): an empty lock file made the same request wait the store's whole lock
+    time. A lock that names no owner, or whose own deadline has passed, is broken at once."""
+    monkeypatch.setitem(cache.STORES, "check", cache.Store("check", ttl_seconds=60, lock_seconds=5))
+    lock = entry_path("check", {"stale": 1}).with_suffix(".lock")
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    lock.write_bytes(body)
+    start = time.monotonic()
+    assert cache.get_or_compute("check", {"stale": 1}, lambda: {"ok": 1}) == {"ok": 1}
+    assert time.monotonic() - start < 1.5
+    assert not lock.exists()
