@@ -1,0 +1,92 @@
+"""Every key verified by a second route before a student sees it (issue 27, item 3).
+
+The second route is sympy's own mechanics (kinetic_energy, LagrangesMethod) on the spec's
+bodies; a key that disagrees with it, or that sympy cannot show equal, makes the variant
+undeployable, and the preview says why.
+"""
+
+from __future__ import annotations
+
+import pytest
+import sympy as sp
+
+import mechanics.check
+from mechanics.assignments import verify
+from mechanics.assignments.keys import derivation, variant_keys
+from mechanics.assignments.template import shipped_templates
+from mechanics.assignments.variants import build_variant
+
+from .support import one_part
+
+
+@pytest.mark.parametrize("template_id", sorted(shipped_templates()))
+def test_every_shipped_templates_keys_are_verified(template_id):
+    for seed in ("1", "2"):
+        keys = variant_keys(build_variant(shipped_templates()[template_id], seed))
+        assert keys.deployable, keys.why_not
+        assert keys.why_not == ""
+
+
+def test_the_pendulum_keys_are_the_textbook_ones():
+    """T = ½ m l² θ̇², V = −m g l cos θ, and m l² θ̈ + m g l sin θ = 0, by hand."""
+    variant = one_part("simple_pendulum", "T")
+    d = derivation(variant)
+    m, length, g = (d.model.params[n] for n in ("m", "l", "g"))
+    th, thd = d.model.q[0], d.model.qd[0]
+    assert sp.simplify(d.work.T - m * length**2 * thd**2 / 2) == 0
+    assert sp.simplify(d.work.V + m * g * length * sp.cos(th)) == 0
+
+
+def test_a_wrong_key_is_caught_by_the_second_route():
+    variant = one_part("simple_pendulum", "T")
+    d = derivation(variant)
+    m, length = d.model.params["m"], d.model.params["l"]
+    wrong = m * length**2 * d.model.qd[0] ** 2  # twice T
+    check = verify.verify_key(d, "T", None, wrong)
+    assert check.status == "disagrees" and not check.ok
+    assert "LagrangesMethod" in check.why
+
+
+def test_a_wrong_equation_of_motion_key_is_caught():
+    variant = one_part("cart_pendulum", "eom", "theta")
+    d = derivation(variant)
+    w = d.work
+    wrong = w.eom_lhs[1] - w.Q[1] + d.model.params["m"] * d.model.qdd[0]  # a stray m ẍ
+    assert verify.verify_key(d, "eom", 1, wrong).status == "disagrees"
+
+
+def test_a_key_equal_only_at_the_samples_is_unconfirmed_not_verified():
+    """A bump exp(−10⁶ θ̇²) is below the tolerance at every sampled θ̇: the route cannot
+    tell, and says so instead of calling the key verified."""
+    variant = one_part("simple_pendulum", "T")
+    d = derivation(variant)
+    sneaky = d.work.T + sp.exp(-(10**6) * d.model.qd[0] ** 2 - 100)
+    check = verify.verify_key(d, "T", None, sneaky)
+    assert check.status == "unconfirmed"
+
+
+def test_the_second_route_does_not_use_the_checker(monkeypatch):
+    """Not the same code judging itself: with the checker's proofs disabled, keys still verify."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the verification called the checker")
+
+    for name in ("zero_proof", "constant_proof", "check", "expected_quantity"):
+        monkeypatch.setattr(mechanics.check, name, refuse)
+    variant = one_part("spring_mass_damper", "eom", "x")
+    d = derivation(variant)
+    w = d.work
+    assert verify.verify_key(d, "eom", 0, w.eom_lhs[0] - w.Q[0]).ok
+    assert verify.verify_key(d, "Q", 0, w.Q[0]).ok
+
+
+def test_an_undeployable_variant_says_which_part_and_why(monkeypatch):
+    variant = one_part("simple_pendulum", "T")
+
+    def disagree(d, quantity, j, engine):
+        return verify.Check("disagrees", "the two routes differ")
+
+    monkeypatch.setattr("mechanics.assignments.keys.verify_key", disagree)
+    keys = variant_keys(variant)
+    assert not keys.deployable
+    assert keys.why_not == "part 'p': key disagrees: the two routes differ"
