@@ -62,7 +62,13 @@ RHS_SIGNATURE = ctypes.CFUNCTYPE(
 
 
 class NativeUnavailable(RuntimeError):
-    """No compiled path here (no compiler, a failed build, an expression C cannot print)."""
+    """No compiled path here (no compiler, a failed build, an expression C cannot print).
+
+    Its reason reaches clients (a run's ``warnings``): the folders of an absolute path in it (the
+    server's cache, a compiler's temporary files) are cut to the file's name (issue 24)."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(re.sub(r"(?<![\w.~-])/(?:[^/\s'\"]+/)+", "", reason))
 
 
 class _Result(ctypes.Structure):
