@@ -11,6 +11,7 @@ from starlette.middleware.gzip import GZipMiddleware
 from starlette.types import ASGIApp
 
 from app import __version__
+from app.assignments.routes import router as assignments_router
 from app.assets import Assets, content_version, package_version
 from app.derivations import pool_lifespan
 from app.errors import refuse_lone_surrogates, register_error_handlers
@@ -29,9 +30,11 @@ from app.routes import (
     simulate,
 )
 from app.schemas import Health, WarmUp
+from app.settings import settings
 
-#: A request body past this is refused unread: no honest scene comes near it.
-MAX_BODY_BYTES = 1024 * 1024
+#: A request body past this is refused unread: no honest scene comes near it
+#: (``LAGRANGE_LAB_MAX_BODY_BYTES``, 1 MiB by default).
+MAX_BODY_BYTES = settings.max_body_bytes
 #: Smaller answers gain too little from gzip to be worth it. What passes through here is dynamic
 #: (the static bundles are compressed once, app/assets.py): a double pendulum's 193 kB run
 #: compresses to 76.7 kB in 1.5 ms at level 1 against 73.5 kB in 7.2 ms at level 6, and under a
@@ -66,6 +69,7 @@ app.include_router(equilibria.router)
 app.include_router(newton.router)
 app.include_router(export.router)
 app.include_router(precision.router)
+app.include_router(assignments_router)
 app.include_router(pages.router)
 register_error_handlers(app)
 
