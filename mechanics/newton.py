@@ -8,6 +8,10 @@ solved with q̈ from the equations of motion: the tension F_T(θ, θ̇) of a pen
 force F_N of a hoop, the tension F_T of the Atwood machine's string. Each is called what the
 free-body diagram calls it (`fbd.resultant_name`): one force, one name on both panels, and never
 a scene's parameter (R is a radius) nor the kinetic energy T.
+
+A scene's `potentials` are V(q, t), not forces on a body: V fixes only their virtual work, so
+where one depends on the coordinates no constraint force is computed and the reason is given
+instead (`newton_potentials`); the balances projected on δq_j carry −∂V/∂q_j and still hold.
 """
 
 from __future__ import annotations
@@ -43,7 +47,8 @@ class ConstraintForce:
 
 
 def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Expr]]:
-    """Steps, the constraint force on every particle, and the equations Newton's method gives."""
+    """Steps, the constraint force on every particle (none where a potential V(q) leaves them
+    unknown), and the equations Newton's method gives."""
     m = d.model
     acting = body_forces(m)
     placed, _ = constraint_forces(m)
