@@ -11,8 +11,8 @@ from starlette.middleware.gzip import GZipMiddleware
 from starlette.types import ASGIApp
 
 from app import __version__
-from app.assignments.routes import router as assignments_router
 from app.assets import Assets, content_version, package_version
+from app.assignments.routes import router as assignments_router
 from app.derivations import pool_lifespan
 from app.errors import refuse_lone_surrogates, register_error_handlers
 from app.middleware import BodyLimit, HeadAsGet, OneValuePerKey, SecurityHeaders

@@ -94,3 +94,12 @@ def variant_keys(variant: Variant) -> VariantKeys:
             check = Check("unconfirmed", f"the second route failed: {type(exc).__name__}")
         out.append(PartKey(part["id"], plain, latex, check))
     return VariantKeys(out)
+
+
+def deploy_job(template_document: dict[str, Any], seed: str) -> dict[str, Any]:
+    """One variant and its verified keys as JSON (a pool job: module level, picklable)."""
+    from .template import parse_template
+    from .variants import build_variant
+
+    variant = build_variant(parse_template(template_document), seed)
+    return {"variant": variant.to_json(), "keys": variant_keys(variant).to_json()}

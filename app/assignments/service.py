@@ -1,0 +1,374 @@
+"""What the assignment routes do, without HTTP: deploy, a student's view, submit, scores, report.
+
+The engine's work (building and verifying variants, judging answers) goes through ``run``, a
+callable the routes bind to the warm pool under its budgets (tests may bind it to this process).
+Every answer is stored before it is judged (status "pending"), and scored in a second short
+transaction: a server killed in between leaves the answer stored, and `regrade_pending` scores it
+when asked (the routes call it for the assignment before reading scores).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from collections import Counter, defaultdict
+from collections.abc import Callable
+from typing import Any
+
+from mechanics.assignments import grading
+from mechanics.assignments.grading import AttemptsExhausted, Policy
+from mechanics.assignments.keys import deploy_job
+from mechanics.assignments.template import Template, parse_template, template_hash
+from mechanics.assignments.variants import Variant, deploy_seeds
+from mechanics.spec import SpecError
+
+from .store import Store, attempt_of
+
+#: Submissions one student may make per minute, over every assignment and server (counted in
+#: the database, so a second server or a restart does not reset it).
+RATE_ENV = "LAGRANGE_LAB_SUBMISSIONS_PER_MINUTE"
+DEFAULT_RATE = 30
+MAX_DEPLOY = 50
+HISTOGRAM_BINS = 10
+
+Run = Callable[..., Any]  # run(job, *args, what=..., budget="check"|"derive", affinity=...)
+
+
+class Refused(Exception):
+    """A request the rules refuse: ``status`` (404, 409, 429, ...) with one field and message."""
+
+    def __init__(self, status: int, field: str, message: str) -> None:
+        super().__init__(message)
+        self.status, self.field, self.message = status, field, message
+
+
+def submissions_per_minute() -> int:
+    raw = os.environ.get(RATE_ENV, "")
+    return int(raw) if raw.strip().isdigit() and int(raw) > 0 else DEFAULT_RATE
+
+
+def local_run(job: Callable[..., Any], *args: Any, **_: Any) -> Any:
+    """Run a job in this process (the CLI, tests): no budget."""
+    return job(*args)
+
+
+def find_template(store: Store, template_id: str) -> Template:
+    """A stored template, else a shipped one; Refused(404) if neither."""
+    from mechanics.assignments.template import shipped_templates
+
+    document = store.template(template_id)
+    if document is not None:
+        return parse_template(document)
+    shipped = shipped_templates().get(template_id)
+    if shipped is None:
+        raise Refused(404, "template_id", f"no template '{template_id}'")
+    return shipped
+
+
+def deploy(
+    store: Store,
+    template: Template,
+    assignment_id: str,
+    count: int,
+    pinned: list[str],
+    run: Run = local_run,
+) -> dict[str, Any]:
+    """Build ``count`` variants (pinned seeds first), verify every key, store the assignment.
+    A variant whose keys are not all verified is stored as not deployable, with the reason,
+    and no student ever gets it."""
+    if store.assignment(assignment_id) is not None:
+        raise Refused(409, "assignment_id", f"assignment '{assignment_id}' exists already")
+    if not 1 <= count <= MAX_DEPLOY or len(pinned) > count:
+        raise Refused(422, "count", f"between 1 and {MAX_DEPLOY}, and at least the pinned seeds")
+    document = template.model_dump(mode="json", exclude_defaults=True)
+    rows = []
+    for seed in deploy_seeds(count, pinned):
+        try:
+            built = run(deploy_job, document, seed, what="verifying a variant's keys")
+        except SpecError as exc:  # a switch that breaks the scene: not deployable, say why
+            why = "; ".join(f"{e['field']}: {e['message']}" for e in exc.errors)
+            rows.append(_undeployable(template, seed, f"the variant's scene is invalid: {why}"))
+            continue
+        except Exception as exc:  # past the budget, a lost worker: never deployed
+            rows.append(_undeployable(template, seed, f"its keys could not be verified: {exc}"))
+            continue
+        keys = built["keys"]
+        rows.append(
+            {
+                "seed": seed,
+                "engine_version": built["variant"]["engine_version"],
+                "variant": built["variant"],
+                "keys": keys,
+                "deployable": keys["deployable"],
+                "why_not": keys["why_not"],
+            }
+        )
+    store.create_assignment(assignment_id, document, template_hash(template), rows)
+    return preview(store, assignment_id)
+
+
+def _undeployable(template: Template, seed: str, why: str) -> dict[str, Any]:
+    from mechanics.cache import ENGINE_VERSION
+
+    return {
+        "seed": seed,
+        "engine_version": ENGINE_VERSION,
+        "variant": {"seed": seed, "template_id": template.id},
+        "keys": {"deployable": False, "why_not": why, "parts": []},
+        "deployable": False,
+        "why_not": why,
+    }
+
+
+def _assignment(store: Store, assignment_id: str) -> Any:
+    row = store.assignment(assignment_id)
+    if row is None:
+        raise Refused(404, "assignment_id", f"no assignment '{assignment_id}'")
+    return row
+
+
+def preview(store: Store, assignment_id: str) -> dict[str, Any]:
+    """For instructors: every variant with its keys and whether it is deployed (and why not)."""
+    row = _assignment(store, assignment_id)
+    return {
+        "assignment_id": row.id,
+        "template_id": row.template_id,
+        "template_sha256": row.template_sha256,
+        "closed": row.closed,
+        "variants": [
+            {
+                "seed": v.seed,
+                "engine_version": v.engine_version,
+                "deployable": v.deployable,
+                "why_not": v.why_not,
+                "parameters": v.variant.get("parameters", {}),
+                "switches": v.variant.get("switches", {}),
+                "keys": v.keys.get("parts", []),
+            }
+            for v in store.variants(assignment_id)
+        ],
+    }
+
+
+def _policy(template: dict[str, Any], part: dict[str, Any]) -> Policy:
+    return Policy(
+        retry_penalty=template.get("retry_penalty", 0.1),
+        max_attempts=template.get("max_attempts", 0),
+        partial=dict(part.get("partial", {})),
+    )
+
+
+def student_view(store: Store, assignment_id: str, student: str) -> dict[str, Any]:
+    """A student's own variant, without any key: the scene, the parts, attempts and scores."""
+    row = _assignment(store, assignment_id)
+    chosen = store.variant_of(assignment_id, student)
+    if chosen is None:
+        raise Refused(409, "assignment_id", "this assignment has no deployable variant")
+    variant = chosen.variant
+    done = defaultdict(list)
+    for sub in store.attempts(assignment_id, student):
+        done[sub.part].append(sub)
+    parts, scores = [], {}
+    for part in variant["parts"]:
+        attempts = [attempt_of(s) for s in done[part["id"]]]
+        policy = _policy(row.template, part)
+        scores[part["id"]] = grading.part_score(attempts)
+        last = done[part["id"]][-1] if done[part["id"]] else None
+        parts.append(
+            {
+                "id": part["id"],
+                "quantity": part["quantity"],
+                "coordinate": part.get("coordinate"),
+                "weight": part["weight"],
+                "prompt": part.get("prompt", ""),
+                "attempts_used": sum(1 for a in attempts if a.counted),
+                "attempts_left": grading.attempts_left(attempts, policy),
+                "score": scores[part["id"]],
+                "last": None if last is None else _submission_json(last),
+            }
+        )
+    return {
+        "assignment_id": row.id,
+        "title": row.template.get("title", ""),
+        "mode": row.template.get("mode", "graded"),
+        "closed": row.closed,
+        "seed": chosen.seed,
+        "scene": variant["spec"],
+        "parameters": variant["parameters"],
+        "parts": parts,
+        "score": grading.total_score(variant["parts"], scores),
+    }
+
+
+def _submission_json(row: Any) -> dict[str, Any]:
+    return {
+        "submission_id": row.id,
+        "part": row.part,
+        "answer": row.answer,
+        "status": row.status,
+        "code": row.code,
+        "decided": row.decided,
+        "counted": row.counted,
+        "attempt": row.number,
+        "score": row.score,
+        "feedback": row.feedback or [],
+        "answer_latex": row.answer_latex or "",
+    }
+
+
+def submit(
+    store: Store,
+    assignment_id: str,
+    student: str,
+    part_id: str,
+    answer: str,
+    request_id: str | None = None,
+    run: Run = local_run,
+) -> dict[str, Any]:
+    """Store the answer, then judge it and store its score; the stored row's JSON."""
+    row = _assignment(store, assignment_id)
+    if row.closed:
+        raise Refused(409, "assignment_id", "this assignment is closed")
+    chosen = store.variant_of(assignment_id, student)
+    if chosen is None:
+        raise Refused(409, "assignment_id", "this assignment has no deployable variant")
+    part = next((p for p in chosen.variant["parts"] if p["id"] == part_id), None)
+    if part is None:
+        raise Refused(404, "part_id", f"no part '{part_id}' in this assignment")
+    policy = _policy(row.template, part)
+    previous = [attempt_of(s) for s in store.attempts(assignment_id, student, part_id)]
+    left = grading.attempts_left(previous, policy)
+    if left == 0 and not any(a.answer.strip() == answer.strip() for a in previous):
+        raise Refused(409, "answer", f"all {policy.max_attempts} attempts of this part are used")
+    limit = submissions_per_minute()
+    if store.recent_submissions(student, 60) >= limit:
+        raise Refused(429, "answer", f"more than {limit} submissions in a minute; wait a little")
+    stored, new = store.store_pending(assignment_id, student, part_id, answer, request_id)
+    if not new and stored.status == "graded":
+        return _submission_json(stored)
+    return _submission_json(_grade(store, stored, chosen.variant, part, policy, previous, run))
+
+
+def _grade(store, stored, variant_json, part, policy, previous, run) -> Any:  # noqa: ANN001
+    variant = Variant.from_json(variant_json)
+
+    def budgeted(spec_text, quantity, coordinate, answer):  # noqa: ANN001, ANN202
+        return run(
+            grading.judge_job,
+            spec_text,
+            quantity,
+            coordinate,
+            answer,
+            what="checking this answer",
+            budget="check",
+            affinity=spec_text,
+        )
+
+    judged = grading.judge(variant, part, stored.answer, run=budgeted)
+    try:
+        attempt = grading.record(previous, stored.answer, judged, policy)
+    except AttemptsExhausted:
+        attempt = grading.Attempt(stored.answer, judged, False, None, None, None)
+    return store.finish(stored.id, attempt)
+
+
+def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> int:
+    """Score every answer stored but not scored (its server stopped in between); how many."""
+    row = _assignment(store, assignment_id)
+    count = 0
+    for sub in store.pending(assignment_id):
+        chosen = store.variant_of(assignment_id, sub.student)
+        part = next((p for p in chosen.variant["parts"] if p["id"] == sub.part), None)
+        if part is None:
+            continue
+        previous = [attempt_of(s) for s in store.attempts(assignment_id, sub.student, sub.part)]
+        _grade(store, sub, chosen.variant, part, _policy(row.template, part), previous, run)
+        count += 1
+    return count
+
+
+def scores(store: Store, assignment_id: str) -> dict[str, Any]:
+    """Each student's best penalised score per part and the weighted total."""
+    row = _assignment(store, assignment_id)
+    parts = row.template["parts"]
+    weights = [{"id": p["id"], "weight": p.get("weight", 1.0)} for p in parts]
+    by_student: dict[str, dict[str, list]] = defaultdict(lambda: defaultdict(list))
+    pending = Counter()
+    for sub in store.submissions(assignment_id):
+        if sub.status == "graded":
+            by_student[sub.student][sub.part].append(attempt_of(sub))
+        else:
+            pending[sub.student] += 1
+    seeds = {}
+    variants = {v.id: v.seed for v in store.variants(assignment_id)}
+    for e in store.enrolments(assignment_id):
+        seeds[e.student] = variants.get(e.variant_id)
+    students = []
+    for student in sorted(set(seeds) | set(by_student)):
+        part_scores = {p["id"]: grading.part_score(by_student[student][p["id"]]) for p in parts}
+        students.append(
+            {
+                "student": student,
+                "seed": seeds.get(student),
+                "parts": part_scores,
+                "attempts": {
+                    p["id"]: sum(1 for a in by_student[student][p["id"]] if a.counted)
+                    for p in parts
+                },
+                "pending": pending[student],
+                "total": round(grading.total_score(weights, part_scores), 6),
+            }
+        )
+    return {"assignment_id": assignment_id, "students": students}
+
+
+def report(store: Store, assignment_id: str) -> dict[str, Any]:
+    """Per part: the distribution of the students' scores (10 bins) and the count of each
+    outcome code over the decided submissions, with the share of students who had it once."""
+    table = scores(store, assignment_id)
+    row = _assignment(store, assignment_id)
+    students = table["students"]
+    codes: dict[str, Counter] = defaultdict(Counter)
+    who: dict[str, dict[str, set]] = defaultdict(lambda: defaultdict(set))
+    for sub in store.submissions(assignment_id):
+        if sub.status == "graded" and sub.decided and sub.code:
+            codes[sub.part][sub.code] += 1
+            who[sub.part][sub.code].add(sub.student)
+    parts = []
+    for p in row.template["parts"]:
+        values = [s["parts"][p["id"]] for s in students]
+        bins = [0] * HISTOGRAM_BINS
+        for v in values:
+            bins[min(HISTOGRAM_BINS - 1, int(v * HISTOGRAM_BINS))] += 1
+        parts.append(
+            {
+                "part": p["id"],
+                "students": len(values),
+                "mean": round(sum(values) / len(values), 6) if values else None,
+                "histogram": bins,
+                "codes": [
+                    {
+                        "code": code,
+                        "submissions": n,
+                        "students": len(who[p["id"]][code]),
+                        "share": round(len(who[p["id"]][code]) / len(values), 6) if values else 0.0,
+                    }
+                    for code, n in codes[p["id"]].most_common()
+                ],
+            }
+        )
+    return {"assignment_id": assignment_id, "students": len(students), "parts": parts}
+
+
+def report_csv(data: dict[str, Any]) -> str:
+    """The report as CSV: one row per (part, outcome code); cells never start with = + - @."""
+    out = io.StringIO()
+    writer = csv.writer(out)
+    writer.writerow(["part", "code", "submissions", "students", "share", "mean_score"])
+    for part in data["parts"]:
+        for c in part["codes"]:
+            writer.writerow(
+                [part["part"], c["code"], c["submissions"], c["students"], c["share"], part["mean"]]
+            )
+    return out.getvalue()
