@@ -12,6 +12,7 @@ from functools import partial
 
 import uvicorn
 
+from app.assignments.cli import add_token_command, run_token
 from app.server import HEADER_TIMEOUT, HeaderDeadlineProtocol
 
 
@@ -21,6 +22,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="lagrange-lab", description="Lagrange Lab: analytical mechanics, step by step."
     )
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    add_token_command(commands)  # lagrange-lab token create (app/assignments/cli.py)
     serve = commands.add_parser("serve", help="start the web app (http://127.0.0.1:8000)")
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="port to bind (default 8000)")
@@ -64,6 +66,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the console script and of ``python -m app``; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.command == "token":
+        return run_token(args)
     if args.command != "serve":
         parser.print_help()
         return 2
