@@ -496,3 +496,44 @@ def test_a_stale_lock_is_recognised_at_once(body, monkeypatch):
     assert cache.get_or_compute("check", {"stale": 1}, lambda: {"ok": 1}) == {"ok": 1}
     assert time.monotonic() - start < 1.5
     assert not lock.exists()
+
+
+SHARE = """
+import json, sys
+import mechanics
+from mechanics import cache
+assert mechanics.__file__.startswith(sys.argv[1]), mechanics.__file__
+print(json.dumps(cache.get_or_compute("newton", {"spec": "deployed"}, lambda: {"by": sys.argv[2]})))
+"""
+
+
+def test_deployments_with_the_same_version_but_different_code_share_no_entry(tmp_path):
+    """Issue 24 (item 6): two servers with the same ENGINE_VERSION but different engine code read
+    each other's entries. Three copies of the engine share one cache folder: a copy identical to
+    the first reads its entry, a copy with one changed source computes its own."""
+    copies = {}
+    for name in ("first", "same", "changed"):
+        copies[name] = tmp_path / name
+        shutil.copytree(
+            ROOT / "mechanics",
+            copies[name] / "mechanics",
+            ignore=shutil.ignore_patterns("__pycache__"),
+        )
+    with open(copies["changed"] / "mechanics" / "equilibria.py", "a") as f:
+        f.write("\n# a deployment with one more line of engine code\n")
+
+    def run(name: str) -> dict:
+        done = subprocess.run(
+            [sys.executable, "-c", SHARE, str(copies[name]), name],
+            cwd=copies[name],
+            env=os.environ | {cache.ENV_VAR: str(tmp_path / "shared-cache")},
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        return json.loads(done.stdout)
+
+    assert run("first") == {"by": "first"}
+    assert run("same") == {"by": "first"}  # the same code: the entry is shared
+    assert run("changed") == {"by": "changed"}  # other code: never the first one's entry
