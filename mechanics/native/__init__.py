@@ -104,8 +104,8 @@ def _build(source: str, kind: str) -> ctypes.CDLL:
 
     A cached library is loaded only when its sidecar (``<name>.json``) records the sha256 of the
     library's bytes and of the source it was built from and both match: a truncated, damaged or
-    swapped file is rebuilt, never run. Libraries are never taken from another machine; only the
-    source may be shared (the ``native-source`` store of mechanics/cache.py)."""
+    swapped file is rebuilt, never run. Nothing of it is taken from another machine: each one
+    generates the C itself (7-26 ms for the built-in scenes, too little to share through Redis)."""
     cc = compiler()
     if cc is None:
         raise NativeUnavailable("no C compiler found (install gcc, or set LAGRANGE_LAB_CC)")
@@ -437,9 +437,10 @@ _RHS_HEAD = [
 
 def is_generated_source(source: object) -> bool:
     """Is ``source`` what `rhs_source` prints, line by line? The check a right-hand side's C
-    passes before it is compiled when it comes from the shared cache (the ``native-source``
-    store): assignments of whitelisted expressions to numbered slots, the fixed solver, nothing
-    else (no other function, directive, comment or call outside libm)."""
+    would have to pass before it is compiled if it ever came from outside this process (none
+    does today: the source is not shared through the cache): assignments of whitelisted
+    expressions to numbered slots, the fixed solver, nothing else (no other function, directive,
+    comment or call outside libm)."""
     if not isinstance(source, str):
         return False
     first, _, rest = source.replace(_SOLVE, "\n", 1).partition("\n")
