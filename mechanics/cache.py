@@ -11,11 +11,12 @@ The stores (`STORES`; a name outside this list is a programming error):
 - ``equilibria``    equilibria of a scene at given parameters; keyed by spec + parameters.
 - ``newton``        Newton's method beside Lagrange's for a scene; keyed by the spec.
 - ``check``         a judged answer; keyed by spec + quantity + answer + coordinate + reveal.
-- ``native-source`` the generated C of a scene's right-hand side (text); keyed by spec + branches.
 - ``live-module`` a posted scene's live equations printed as a JavaScript module (text), keyed by
   its digest, so that every worker process serves the module any of them printed.
-  Only the source is shared: mechanics/native compiles it and verifies the library on this
-  machine, and never takes a binary from another one.
+
+The generated C of a scene's right-hand side is not shared: each machine generates it (7-26 ms
+for the built-in scenes, less than a compile) and compiles and verifies its own library
+(mechanics/native).
 
 Every entry is keyed by ``key_for(store, key_parts)``: sha256 of the canonical JSON (sorted keys,
 no whitespace) of the store, the engine (`engine_id()`: `ENGINE_VERSION` and `CODE_HASH`, a hash
@@ -128,7 +129,6 @@ STORES: dict[str, Store] = {
         Store("equilibria", ttl_seconds=7 * DAY, memory_items=512),
         Store("newton", ttl_seconds=30 * DAY),
         Store("check", ttl_seconds=7 * DAY, memory_items=1024),
-        Store("native-source", ttl_seconds=30 * DAY, memory_items=64),
         Store("live-module", ttl_seconds=30 * DAY, write_before_answer=True),
     )
 }
