@@ -441,7 +441,7 @@ def test_a_library_without_its_record_is_rebuilt(libraries, monkeypatch):
     assert accelerations(sources) == [-1.0, -5.0] and len(runs) == 1
 
 
-# --- C source from the shared cache: checked before it is compiled -----------------------------
+# --- C source from outside the process would be checked before it is compiled (none is shared) --
 
 
 def test_every_generated_source_passes_the_check_of_a_shared_source():
