@@ -5,8 +5,10 @@ side (a C build) and its first equilibria (sympy's solve): a lecture hall that o
 the same moment would all wait for that. The server does it for every built-in scene when it
 starts, in the background: `warm_in_process` in the server's own process (its simulations run
 there), `warm_in_worker` in the pool worker that the scene's analysis requests go to (the pool
-sends a scene to the same worker each time). Derivations and compiled libraries land in the
-shared cache too, so a restarted server or another machine finds them.
+sends a scene to the same worker each time). Derivations land in the shared cache too, so a
+restarted server or another machine finds them; compiled libraries land in this machine's disk
+cache (each machine generates and compiles its own C). A cache that cannot write (a full disk, a
+hung Redis) only makes warming slower, never fail.
 """
 
 from __future__ import annotations
