@@ -13,7 +13,7 @@ from functools import partial
 import uvicorn
 
 from app.assignments.cli import add_token_command, run_token
-from app.server import HEADER_TIMEOUT, HeaderDeadlineProtocol
+from app.server import HEADER_TIMEOUT, HeaderDeadlineProtocol, install_connection_guard
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -78,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.pool_workers is not None and args.pool_workers < 1:
         parser.error("--pool-workers must be at least 1")
     pool_workers(args.pool_workers, args.workers)
+    install_connection_guard()  # app.main installs it too, in every worker it is imported in
     uvicorn.run(
         "app.main:app",
         host=args.host,

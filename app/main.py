@@ -15,7 +15,7 @@ from app.assets import Assets, content_version, package_version
 from app.assignments.routes import router as assignments_router
 from app.derivations import pool_lifespan
 from app.errors import refuse_lone_surrogates, register_error_handlers
-from app.middleware import BodyLimit, HeadAsGet, OneValuePerKey, SecurityHeaders
+from app.middleware import BodyLimit, HeadAsGet, OneValuePerKey, RequestDeadline, SecurityHeaders
 from app.paths import STATIC_DIR, api_docs_dir, mathjax_dir, plotly_dir
 from app.responses import ORJSONResponse
 from app.routes import (
@@ -30,6 +30,7 @@ from app.routes import (
     simulate,
 )
 from app.schemas import Health, WarmUp
+from app.server import install_connection_guard
 from app.settings import settings
 
 #: A request body past this is refused unread: no honest scene comes near it
@@ -48,8 +49,17 @@ class LagrangeLab(FastAPI):
     answer, the 500s that Starlette's error middleware sends included."""
 
     def build_middleware_stack(self) -> ASGIApp:
-        return SecurityHeaders(HeadAsGet(super().build_middleware_stack()))
+        limited = RequestDeadline(
+            super().build_middleware_stack(),
+            body_seconds=settings.body_seconds,
+            max_header_bytes=settings.max_header_bytes,
+        )
+        return SecurityHeaders(HeadAsGet(limited))
 
+
+# Header deadline, header size and connections per client in uvicorn's protocols, however the
+# app is served (lagrange-lab serve, python -m uvicorn app.main:app, gunicorn's UvicornWorker).
+install_connection_guard()
 
 app = LagrangeLab(
     lifespan=pool_lifespan,  # the worker pool starts warm before the first request

@@ -8,10 +8,16 @@
   key, before any route reads it (a route's ``Query`` would take the last value silently).
 - ``BodyLimit``: a body past the limit is refused with 413 as it streams in, whether it announced
   its length or came chunked; it is never read into memory whole.
+- ``RequestDeadline``: a body must arrive whole within ``body_seconds`` of its headers (else 408,
+  and the connection is closed); an answer sent before its request's body arrived whole closes
+  the connection (so a body trickled to a route that ignores it holds nothing); request headers
+  past ``max_header_bytes`` are a 431 on any server (app/server.py refuses them as they arrive
+  under uvicorn, reading no further).
 """
 
 from __future__ import annotations
 
+import asyncio
 import secrets
 import time
 from collections import Counter
@@ -181,3 +187,77 @@ class BodyLimit:
 
 def _size(n: int) -> str:
     return f"{n // (1024 * 1024)} MiB" if n % (1024 * 1024) == 0 else f"{n} bytes"
+
+
+class RequestDeadline:
+    """Bounds how long a request may take to arrive, whatever serves the app (issue 24: a body
+    sent a byte at a time was held for ever; the server's deadline stopped at the headers).
+
+    The body's clock starts when the app gets the request (its headers have arrived): each
+    receive waits at most what is left of ``body_seconds``; past it the app is told the client
+    left and the client is answered 408 in the one error shape, with ``Connection: close``. An
+    answer started while the body is still on its way (a route that never reads it) also says
+    ``Connection: close``, so the server closes the connection instead of waiting for the rest.
+    """
+
+    def __init__(self, app: ASGIApp, body_seconds: float, max_header_bytes: int) -> None:
+        self.app = app
+        self.body_seconds = body_seconds
+        self.max_header_bytes = max_header_bytes
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        size = len(scope.get("raw_path") or b"") + len(scope.get("query_string", b""))
+        size += sum(len(k) + len(v) + 4 for k, v in scope.get("headers", ()))
+        if size > self.max_header_bytes:
+            body = error_body("headers", f"request headers over {self.max_header_bytes} bytes")
+            await ORJSONResponse(body, status_code=431, headers={"connection": "close"})(
+                scope, receive, send
+            )
+            return
+        headers = Headers(scope=scope)
+        complete = headers.get("content-length", "0") in ("", "0") and (
+            "transfer-encoding" not in headers
+        )
+        deadline = asyncio.get_running_loop().time() + self.body_seconds
+        late = started = False
+
+        async def timed_receive() -> Message:
+            nonlocal complete, late
+            if complete:
+                return await receive()
+            if late:
+                return {"type": "http.disconnect"}
+            left = deadline - asyncio.get_running_loop().time()
+            try:
+                message = await asyncio.wait_for(receive(), timeout=max(left, 0.0))
+            except TimeoutError:
+                late = True
+                return {"type": "http.disconnect"}
+            if message["type"] != "http.request" or not message.get("more_body", False):
+                complete = True
+            return message
+
+        async def closing_send(message: Message) -> None:
+            nonlocal started
+            if late:
+                return  # the app's answer to a body it never got whole; the 408 replaces it
+            if message["type"] == "http.response.start":
+                started = True
+                if not complete:
+                    MutableHeaders(scope=message)["connection"] = "close"
+            await send(message)
+
+        try:
+            await self.app(scope, timed_receive, closing_send)
+        except Exception:
+            if not late:
+                raise
+        if late and not started:
+            body = error_body(
+                "body", f"the request body did not arrive within {self.body_seconds:g} s"
+            )
+            response = ORJSONResponse(body, status_code=408, headers={"connection": "close"})
+            await response(scope, receive, send)

@@ -51,6 +51,15 @@ class Settings:
     trust_forwarded: bool = False
     #: Largest request body in bytes; a larger one is refused with 413 as it streams in.
     max_body_bytes: int = 1024 * 1024
+    #: Seconds a client has to send a request's headers (app/server.py); then it is closed.
+    header_seconds: float = 10.0
+    #: Seconds a client has to send a request's whole body once its headers came; then 408.
+    body_seconds: float = 30.0
+    #: Largest request line and headers in bytes; larger: 431, read no further (app/server.py).
+    max_header_bytes: int = 32 * 1024
+    #: Connections one client address may hold to one server process; more: 429 and closed.
+    #: Not applied with ``trust_forwarded`` (every connection is then the proxy's).
+    client_connections: int = 128
     #: "0" switches off making every built-in scene ready when the server starts (derivation,
     #: compiled equations, equilibria; in the background): the first request then pays for it.
     warm: bool = True
