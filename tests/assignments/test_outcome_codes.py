@@ -152,3 +152,13 @@ def test_codes_carry_no_parameters():
     """A code is the same for every variant: no number, no symbol of the scene in it."""
     for kind in outcomes.table():
         assert kind["kind"].replace("_", "").isalpha()
+
+
+def test_the_documented_table_is_the_codes_table():
+    """docs/assignments.md lists every kind, in the order they are tried."""
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "assignments.md").read_text()
+    listed = [line.split("`")[1] for line in doc.splitlines() if line.startswith("| `")]
+    kinds = [row["kind"] for row in outcomes.table()]
+    assert [k for k in listed if k in kinds] == kinds
