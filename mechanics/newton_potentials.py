@@ -28,25 +28,36 @@ def coordinate_potentials(model: Any) -> list[str]:
     ]
 
 
-def unknown_constraint_forces(model: Any) -> str | None:
+def unknown_constraint_forces(model: Any, *, plain: bool = False) -> str | None:
     """Why the constraint forces are not computed, or None when they are.
 
-    One sentence for every place that would otherwise show them (the /newton response, the
-    Newton step, the free-body diagram, a run's `constraint_forces`)."""
+    One sentence for every place that would otherwise show them: the /newton response, the
+    Newton step and the free-body diagram carry its math as LaTeX between $…$ (as every step's
+    prose does); a run's warnings, shown as text, take it ``plain``."""
     names = coordinate_potentials(model)
     if not names:
         return None
     which = ", ".join(f"'{n}'" for n in names)
     its = "potential" if len(names) == 1 else "potentials"
+    math = _PLAIN if plain else _LATEX
     return (
-        f"The constraint forces are not computed: the scene's {its} {which} "
-        "is given as a function of the coordinates, V(q), which fixes only the part of its "
-        "force along the directions the bodies may move (its virtual work −∂V/∂q_j), not "
-        "which body it acts on nor how hard it pushes across the constraints (a pull that "
-        "presses a bead into its ring), and the constraint force R = m a − ΣF needs the whole "
-        "force. Newton's equations projected on each δq_j still hold. To have the constraint "
+        f"The constraint forces are not computed: the scene's {its} {which} is given as a "
+        f"function of the coordinates, {math['V']}, which fixes only the part of its force "
+        f"along the directions the bodies may move (its virtual work {math['dV']}), not which "
+        "body it acts on nor how hard it pushes across the constraints (a pull that presses a "
+        f"bead into its ring), and the constraint force {math['R']} needs the whole force. "
+        f"Newton's equations projected on each {math['dq']} still hold. To have the constraint "
         "forces, write the pull as a spring or as a force on the body it acts on."
     )
+
+
+_LATEX = {
+    "V": "$V(q)$",
+    "dV": r"$-\partial V/\partial q_j$",
+    "R": r"$\vec R = m\vec a - \sum \vec F$",
+    "dq": r"$\delta q_j$",
+}
+_PLAIN = {"V": "V(q)", "dV": "−∂V/∂q_j", "R": "R = m a − ΣF", "dq": "δq_j"}
 
 
 def potential_virtual_work(model: Any) -> list[sp.Expr]:

@@ -875,7 +875,7 @@ def _constraint_forces(c, t, q, qd, params, warnings) -> dict[str, dict[str, lis
     from mechanics.newton_potentials import unknown_constraint_forces
 
     out = {}
-    unknown = unknown_constraint_forces(c.derivation.model)
+    unknown = unknown_constraint_forces(c.derivation.model, plain=True)
     if unknown is not None:  # a potential V(q): none is computed, and the run says why
         warnings.append(unknown)
     for body, (fn, tension_fn) in constraint_force_functions(c).items():
