@@ -22,6 +22,7 @@ from typing import Any
 import sympy as sp
 from sympy.simplify.fu import TR5
 
+from mechanics import check_approximations as approximations
 from mechanics import units
 from mechanics.answers import read_answer
 from mechanics.check_identities import (  # noqa: F401  (re-exported: the proofs' budget)
@@ -31,6 +32,8 @@ from mechanics.check_identities import (  # noqa: F401  (re-exported: the proofs
     zero_by_algebra,
 )
 from mechanics.check_identities import expansion_size as _expansion_size
+from mechanics.check_potential import missing_potential
+from mechanics.check_slips import sign_in_group
 from mechanics.derive import Derivation
 from mechanics.expr import parse
 from mechanics.expr import to_latex as _latex_of
@@ -301,6 +304,7 @@ def check(d: Derivation, quantity: str, answer: str, coordinate: str | None = No
     verdict = Verdict(False, answer_latex=shown, expected_latex=_latex(d, quantity, j))
     judge = _Judge(d, quantity, j, expected, given, moved)
     judge.typed_terms = _typed_terms(answer)
+    judge.text = answer  # the brackets as typed: a sign slip is named in them (check_slips)
     judge.run(verdict)
     return verdict
 
@@ -1051,7 +1055,7 @@ class _Judge:
             self._how_it_holds(given, expected, fb)
             if fb:
                 return
-        if self._inertia_only(given, expected, fb):
+        if sign_in_group(self, expected, fb) or self._inertia_only(given, expected, fb):
             return
         scale = self._scaling(given, expected)
         if scale is None:  # r φ̈ for m r² φ̈: no term in common, the q̈ terms still say the factor
@@ -1354,8 +1358,13 @@ class _Judge:
         ratio = self._ratio(given, expected)
         # a fixed multiple of the derived result approximates nothing: the approximation is
         # looked for only when there is no one factor (and its proofs cost a second on a q̈)
+        dropped = missing_potential(self, given, expected) if ratio in (None, 0) else []
+        if dropped or (ratio in (None, 0) and sign_in_group(self, expected, dropped)):
+            fb += dropped + self._units(given)  # V left out, not approximated; or a sign slip
+            return
         small_angle = ratio in (None, 0) and (
-            self._small_angle(given, expected) or self._linearised(given, expected)
+            approximations.small_angle(self, given, expected)
+            or approximations.linearised(self, given, expected)
         )
         if small_angle:
             fb.append(small_angle)
@@ -1598,98 +1607,6 @@ class _Judge:
                 f"be {self._show(theirs)}."
             )
         return f"You have {self._show(mine)} where {self._show(theirs)} belongs."
-
-    def _small_angle(self, given: sp.Expr, expected: sp.Expr) -> str:
-        """A sentence when the answer is the derived result with sin x ≈ x, cos x ≈ 1 (or
-        1 − x²/2), tan x ≈ x: an approximation, valid only near the angles' zero, not a slip.
-
-        Judged group by group of velocity monomials (T's cross term may be cos(θ₁ − θ₂) ≈ 1
-        while V keeps its cos θ₁ exact, or takes 1 − θ₁²/2), each match proved, not sampled."""
-        if self.quantity == "accel":
-            return ""  # a quotient has no velocity groups to speak of: _linearised reads it
-        g, e = self._canonical(given), self._canonical(expected)
-        if len(g) + len(e) > MAX_TERMS:
-            return ""
-        if self.quantity in ("V", "L"):  # the datum: 1 − θ²/2 may come without its 1
-            g, e = {k: v for k, v in g.items() if k != 1}, {k: v for k, v in e.items() if k != 1}
-        used: dict[sp.Expr, sp.Expr] = {}
-        for velocity in dict.fromkeys([*map(self._velocity, e), *map(self._velocity, g)]):
-            mine = sp.Add(*(c * k for k, c in g.items() if self._velocity(k) == velocity))
-            theirs = _tidy(
-                sp.Add(*(c * k for k, c in e.items() if self._velocity(k) == velocity)), self.m
-            )
-            if zero_proof(mine - theirs, self.m) is True:
-                continue
-            same = zero_proof
-            if self.quantity in ("V", "L") and velocity == 1:
-                same = constant_proof  # −m g l (1 − θ²/2) and m g l θ²/2 are one datum apart
-            for order in (1, 2):
-                approximate, replaced = self._approximate(theirs, order)
-                if replaced and same(mine - approximate, self.m) is True:
-                    used.update(replaced)
-                    break
-            else:
-                return ""
-        if not used:
-            return ""
-        angles = sorted({q for atom in used for q in self.m.q if atom.has(q)}, key=self.m.q.index)
-        where = " = ".join([*(inline(q)[1:-1] for q in angles), "0"])
-        atoms = sorted(used, key=sp.default_sort_key)
-        taken = ", ".join(f"${to_latex(a)} \\approx {to_latex(used[a])}$" for a in atoms)
-        kept = ", ".join(inline(a) for a in atoms)
-        return (
-            f"This is the small-angle approximation of the right answer ({taken}): valid only "
-            f"for small swings, near ${where}$, not in general. The exact answer keeps "
-            f"{kept}."
-        )
-
-    def _linearised(self, given: sp.Expr, expected: sp.Expr) -> str:
-        """A sentence when the answer is the derived result's Taylor polynomial at rest in the
-        angles: to first order in q, q̇, q̈ for an equation, q̈ or Q (the linearised equation,
-        where sin(θ₁ − θ₂) θ̇₂² is second order and goes), to second order in q, q̇ for T, V, L.
-        The match is proved; "" if there is none."""
-        trig = [f for f in expected.atoms(sp.sin, sp.cos, sp.tan) if f.args[0].has(*self.m.q)]
-        angles = [q for q in self.m.q if any(f.has(q) for f in trig)]
-        if not angles or sp.count_ops(expected) > PROOF_OPS:
-            return ""
-        g, e = self._canonical(given), self._canonical(expected)
-        if len(g) + len(e) > MAX_TERMS or set(g) <= set(e):
-            return ""  # nothing approximated, only terms left out: 'Missing term' says it
-        energy = self.quantity in ("T", "V", "L")
-        to_sym, back = _symbols_for(self.m)
-        small = [to_sym[x] for x in (*angles, *self.m.qd, *([] if energy else self.m.qdd))]
-        eps = sp.Dummy("eps")
-        scaled = expected.xreplace(to_sym).xreplace({x: eps * x for x in small})
-        taylor, term = sp.S.Zero, scaled
-        for k in range(3 if energy else 2):
-            taylor += term.subs(eps, 0) / sp.factorial(k)
-            term = term.diff(eps)
-        taylor = taylor.xreplace(back)
-        same = constant_proof if self.quantity in ("V", "L") else zero_proof
-        if same(given - taylor, self.m) is not True or same(expected - taylor, self.m) is True:
-            return ""
-        where = " = ".join([*(inline(q)[1:-1] for q in angles), "0"])
-        kept = ", ".join(inline(f) for f in sorted(trig, key=sp.default_sort_key))
-        order = "to second order" if energy else "the linearised equation: to first order"
-        return (
-            f"This is the small-angle approximation of the right answer ({order} in the angles "
-            f"and their rates): valid only for small swings, near ${where}$, not in general. "
-            f"The exact answer keeps {kept}."
-        )
-
-    def _approximate(self, e: sp.Expr, order: int) -> tuple[sp.Expr, dict[sp.Expr, sp.Expr]]:
-        """``e`` with sin, cos, tan of the coordinates replaced by their Taylor polynomials at
-        0: sin x ≈ x, tan x ≈ x, and cos x ≈ 1 (order 1) or 1 − x²/2 (order 2)."""
-        replaced: dict[sp.Expr, sp.Expr] = {}
-        for f in e.atoms(sp.sin, sp.cos, sp.tan):
-            x = f.args[0]
-            if not any(x.has(q) for q in self.m.q):
-                continue  # cos(w t): no angle to be small
-            if isinstance(f, sp.cos):
-                replaced[f] = sp.S.One if order == 1 else 1 - x**2 / 2
-            else:
-                replaced[f] = x
-        return e.xreplace(replaced), replaced
 
     def _velocity(self, mono: sp.Expr) -> sp.Expr:
         """The q̇/q̈ part of a canonical monomial: θ̇₁ θ̇₂ of cos θ₁ cos θ₂ θ̇₁ θ̇₂."""
