@@ -1,5 +1,5 @@
-"""Three engine trust leftovers: a zero power that has |·| or sgn in it, an inertia that is not
-positive at an equilibrium, and /newton's forces by name.
+"""Three engine trust leftovers: a zero power that has |·| or sgn in it, a mass or inertia that
+depends on the coordinates (refused since issue 23, item 6), and /newton's forces by name.
 
 1. A force c (sgn(ẋ)|ẋ| − ẋ) is 0 for every real ẋ, yet sympy cannot simplify it: the conserved
    step said it did work and left E off. The zero test must stay sound (a power that is not 0,
@@ -133,7 +133,7 @@ def test_a_force_at_rest_alone_does_no_work_there():
     assert kind == "no sign"
 
 
-# --- 2. a mass or inertia that depends on the coordinates, not positive at an equilibrium -------
+# --- 2. a mass or inertia that depends on the coordinates: refused (issue 23, item 6) --------
 
 
 def trap(mass: str, centre: float, initial: float = 0.0) -> dict:
@@ -171,86 +171,53 @@ def wheel(izz: str, centre: float, extra: dict | None = None) -> dict:
     }
 
 
-def equilibria_of(spec: dict) -> dict:
-    from mechanics.equilibria import equilibria
-
-    return equilibria(derive_model(spec))
-
-
-@pytest.mark.parametrize(("centre", "mass_there"), [(3.0, -1.0), (2.0, 0.0)])
-def test_an_equilibrium_where_the_mass_is_not_positive_is_left_out_naming_the_field(
-    centre, mass_there
-):
-    """m (2 − x) at x = centre is 1·(2 − centre) ≤ 0: no body, so no equilibrium to linearize
-    (it was called "unstable, λ = 1" at x = 3, and "stable" with no inertia at x = 2). The note
-    names the field, and the forces are not said to "never balance"."""
-    out = equilibria_of(trap("m*(2 - x)", centre))
-    assert out["equilibria"] == []
-    note = next(w for w in out["warnings"] if "bodies[0].mass" in w)
-    assert f"x = {centre:g}" in note and f"is {mass_there:g} there" in note, note
-    assert not any("never balance" in w for w in out["warnings"]), out["warnings"]
-
-
-def test_a_negative_or_vanishing_moment_at_an_equilibrium_is_left_out_naming_the_field():
-    """izz = I0 (1 − θ): −1 at θ = 2 (no body has that) and 0 at θ = 1, where the wheel's only
-    inertia about its axis is gone (M = [izz] = 0): both left out, each naming the entry."""
-    for centre, value in ((2.0, "-1"), (1.0, "0")):
-        out = equilibria_of(wheel("I0*(1 - theta)", centre))
-        assert out["equilibria"] == [], out
-        note = next(w for w in out["warnings"] if "bodies[0].inertia.izz" in w)
-        assert f"= {value} there" in note, note
+ROD_SIN2 = {
+    "title": "Rod whose central moment vanishes at the bottom",
+    "coordinates": ["theta"],
+    "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
+    "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
+    "bodies": [
+        {
+            "name": "rod",
+            "kind": "rigid_body",
+            "mass": "m",
+            "frame": "R",
+            "position": {"frame": "R", "components": [0, "-l/2", 0]},
+            "inertia": {"ixx": "m*l**2/12", "iyy": "m*l**2/12", "izz": "m*l**2*sin(theta)**2/12"},
+        }
+    ],
+    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+}
 
 
-def test_a_moment_that_is_positive_or_zero_beside_other_inertia_keeps_its_equilibrium():
-    """No false alarm. izz = I0 (1 − θ) at θ = 0.5 is 0.5: ω = √(k / izz) = √2. A rod pivoted at
-    its end (centre of mass l/2 below) with izz = m l² sin²θ/12, 0 at θ = 0 and π: the pivot's
-    moment m l²/4 remains, M is regular, and at the bottom ω = √(m g l/2 / (m l²/4)) = √(2g/l);
-    the top is kept too (unstable)."""
-    izz = "m*l**2*sin(theta)**2/12"
-    out = equilibria_of(wheel("I0*(1 - theta)", 0.5))
-    (e,) = out["equilibria"]
-    assert e["kind"] == "stable" and e["frequencies"] == pytest.approx([np.sqrt(2.0)])
-    rod = {
-        "title": "Rod whose central moment vanishes at the bottom",
-        "coordinates": ["theta"],
-        "parameters": {"m": 1.0, "l": 1.0, "g": 9.81},
-        "frames": [{"name": "R", "parent": "N", "axis": "z", "angle": "theta"}],
-        "bodies": [
-            {
-                "name": "rod",
-                "kind": "rigid_body",
-                "mass": "m",
-                "frame": "R",
-                "position": {"frame": "R", "components": [0, "-l/2", 0]},
-                "inertia": {"ixx": "m*l**2/12", "iyy": "m*l**2/12", "izz": izz},
-            }
-        ],
-        "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
-    }
-    out = equilibria_of(rod)
-    bottom = next(e for e in out["equilibria"] if abs(e["q"]["theta"]) < 1e-9)
-    assert bottom["kind"] == "stable"
-    assert bottom["frequencies"] == pytest.approx([np.sqrt(2 * 9.81 / 1.0)])
-    assert any(e["kind"] == "unstable" and abs(e["q"]["theta"]) > 3 for e in out["equilibria"])
-    assert not any("inertia" in w for w in out["warnings"]), out["warnings"]
-
-
-def test_the_api_names_the_field_whether_the_request_or_an_equilibrium_is_unphysical():
-    """Through /api/v1/equilibria: a request whose own state has the mass −1 (x = 3) is a 422 in
-    the one error shape naming bodies[0].mass; one starting at x = 0 (mass 2) answers 200 and
-    leaves the point x = 3 out with the same field named."""
+@pytest.mark.parametrize(
+    ("spec", "field"),
+    [
+        (trap("m*(2 - x)", 3.0), "bodies[0].mass"),
+        (trap("m*(2 - x)", 2.0), "bodies[0].mass"),
+        (trap("m*(2 - x)", 3.0, initial=3.0), "bodies[0].mass"),
+        (wheel("I0*(1 - theta)", 2.0), "bodies[0].inertia.izz"),
+        (wheel("I0*(1 - theta)", 0.5), "bodies[0].inertia.izz"),
+        (ROD_SIN2, "bodies[0].inertia.izz"),
+    ],
+)
+def test_a_mass_or_inertia_depending_on_the_coordinates_is_refused_naming_the_field(spec, field):
+    """These specs were once derived and their equilibria judged one by one (a point where
+    m (2 − x) ≤ 0 left out, naming the field). Since issue 23 (item 6) a mass or inertia in the
+    coordinates is refused outright, before any equilibrium: Lagrange's equations here need
+    constant masses (tests/test_variable_mass.py). The refusal names the same field, in the
+    engine and through /api/v1/equilibria."""
     from fastapi.testclient import TestClient
 
     from app.main import app
+    from mechanics.spec import SpecError
 
-    client = TestClient(app)
-    r = client.post("/api/v1/equilibria", json={"scene": trap("m*(2 - x)", 3.0, initial=3.0)})
+    with pytest.raises(SpecError) as caught:
+        derive_model(spec)
+    assert [e["field"] for e in caught.value.errors] == [field]
+    r = TestClient(app).post("/api/v1/equilibria", json={"scene": spec})
     assert r.status_code == 422, r.text
-    assert [e["field"] for e in r.json()["detail"]] == ["bodies[0].mass"], r.json()
-    r = client.post("/api/v1/equilibria", json={"scene": trap("m*(2 - x)", 3.0)})
-    assert r.status_code == 200, r.text
-    assert r.json()["equilibria"] == []
-    assert any("bodies[0].mass" in w for w in r.json()["warnings"]), r.json()["warnings"]
+    assert [e["field"] for e in r.json()["detail"]] == [field], r.json()
 
 
 # --- 3. /api/v1/newton names its forces as the free-body diagram does -------------------------
