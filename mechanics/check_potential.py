@@ -41,6 +41,8 @@ def missing_potential(judge: Any, given: sp.Expr, expected: sp.Expr) -> list[str
     from mechanics.check import constant_proof, zero_proof
 
     quantity, m = judge.quantity, judge.m
+    if quantity == "T":
+        return _potential_in_t(judge, given, expected)
     if quantity not in ("V", "L", "eom", "accel"):
         return []
     if quantity == "accel" and len(m.q) > MAX_SOLVED_COORDINATES:
@@ -68,6 +70,30 @@ def missing_potential(judge: Any, given: sp.Expr, expected: sp.Expr) -> list[str
         )
         if rest:
             return [_sentence(judge, parts, True), rest]
+    return []
+
+
+def _potential_in_t(judge: Any, given: sp.Expr, expected: sp.Expr) -> list[str]:
+    """T written with V in it: T − V (which is L) or T + V (the energy), proved up to a
+    constant (a datum that came along with V)."""
+    from mechanics.check import _tidy, constant_proof, inline
+
+    parts = _moving_parts(judge)
+    if not parts:
+        return []
+    potential = sp.Add(*(p for _, p in parts))
+    gap = judge.values(given - expected, True)
+    for sign, what in ((-1, "T − V, which is L"), (1, "T + V, the energy")):
+        if not _fits(gap, [judge.values(-sign * potential, True)], True):
+            continue
+        if constant_proof(given - expected - sign * potential, judge.m) is True:
+            return [
+                f"Your T is {what}: it has {'−V' if sign < 0 else '+V'} in it, with "
+                f"V = {inline(_tidy(potential, judge.m))} the potential energy of "
+                f"{_sources(parts)}. T is the kinetic energy alone (½ m v² "
+                "of each body, ½ I ω² of each rigid body's rotation); the potential energy "
+                "belongs in V."
+            ]
     return []
 
 

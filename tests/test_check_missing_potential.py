@@ -4,7 +4,7 @@
 prediction view repeated that cause; it is T alone, with the weight's V = −m g l cos θ missing.
 Each answer below is the scene's result written by hand with some or all of V left out (or, as
 a control, with V kept in a true small-angle form, or wrong in some other way), on several
-scenes and for V, L, an equation of motion and q̈.
+scenes and for V, L, an equation of motion and q̈; and T with V written into it (T − V, T + V).
 
 Results by hand from the scene files (angles from the downward vertical):
 - simple pendulum: T = ½ m l² θ̇², V = −m g l cos θ, m l² θ̈ + m g l sin θ = 0;
@@ -218,3 +218,37 @@ def test_the_prediction_view_blames_the_missing_potential():
     assert out["blamed"].startswith("Your L is T alone"), out["blamed"]
     assert "small-angle" not in out["summary"], out["summary"]
     assert "The cause: your L is T alone" in out["summary"], out["summary"]
+
+
+@pytest.mark.parametrize(
+    ("scene", "answer", "written", "source"),
+    [
+        # T − V = ½ m l² θ̇² + m g l cos θ, which is L
+        ("simple_pendulum", "1/2 m l^2 theta'^2 + m g l cos(theta)", "T − V", "weight of the bob"),
+        # T + V, the energy (with a datum 3 m g l along)
+        (
+            "simple_pendulum",
+            "1/2 m l^2 theta'^2 - m g l cos(theta) + 3 m g l",
+            "T + V",
+            "weight of the bob",
+        ),
+        ("spring_mass_damper", "1/2 m x'^2 + 1/2 k x^2", "T + V", "spring"),
+        (
+            "double_pendulum",
+            "(m1+m2)/2 l1^2 theta1'^2 + m2/2 l2^2 theta2'^2"
+            " + m2 l1 l2 cos(theta1 - theta2) theta1' theta2'"
+            " - (-(m1+m2) g l1 cos(theta1) - m2 g l2 cos(theta2))",
+            "T − V",
+            "weights of the bob1 and the bob2",
+        ),
+    ],
+)
+def test_a_kinetic_energy_with_v_in_it_is_named_so(scene, answer, written, source):
+    (line,) = lines(scene, "T", answer)
+    assert line.startswith(f"Your T is {written}") and source in line, line
+    assert "belongs in V" in line, line
+
+
+def test_a_kinetic_energy_with_another_extra_term_is_not_called_t_with_v():
+    fb = lines("simple_pendulum", "T", "1/2 m l^2 theta'^2 + m g l sin(theta)")
+    assert not any(line.startswith("Your T is") for line in fb), fb
