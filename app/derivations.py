@@ -35,6 +35,7 @@ from collections import Counter
 from collections.abc import AsyncIterator, Callable
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 from fastapi import HTTPException, Request
@@ -42,6 +43,7 @@ from starlette.concurrency import run_in_threadpool
 
 from app.schemas import DeriveResponse
 from mechanics.budget import BudgetExceeded
+from mechanics.fair_share import LEDGER, CpuLedger, reserve_for, thread_cpu
 from mechanics.pool import WorkerLost, WorkerPool, busy_message
 from mechanics.scenes import scene_ids
 from mechanics.spec import SceneSpec, parse_spec
@@ -369,12 +371,17 @@ class FairGate:
     in this process's threads). Waiting holds no thread: a flood of waiting requests leaves the
     threadpool to ``/healthz``, pages and everyone else.
 
+    Fair over time too (mechanics/fair_share.py): clients with CPU credit go first, and a client
+    in debt may not take the last free place.
+
     Thread-safe and not bound to one event loop (each waiter is woken on its own loop).
     """
 
-    def __init__(self, total: int, per_client: int) -> None:
+    def __init__(self, total: int, per_client: int, ledger: CpuLedger | None = None) -> None:
         self.total = max(1, total)
         self.per_client = max(1, per_client)
+        self.ledger = ledger or LEDGER
+        self.reserve = reserve_for(self.total)
         self._lock = threading.Lock()
         self._running: Counter[str] = Counter()
         self._waiting: list[_Ticket] = []
@@ -420,11 +427,14 @@ class FairGate:
             self._grant()
 
     def _grant(self) -> None:
-        """Give free places to waiting tickets in arrival order (under the lock)."""
-        for ticket in list(self._waiting):
-            if sum(self._running.values()) >= self.total:
+        """Give free places to waiting tickets in the ledger's order (under the lock)."""
+        for ticket in self.ledger.ordered(self._waiting, key=lambda t: t.client):
+            free = self.total - sum(self._running.values())
+            if free <= 0:
                 return
             if self._running[ticket.client] >= self.per_client:
+                continue
+            if not self.ledger.may_take(ticket.client, free, self.reserve):
                 continue
             self._waiting.remove(ticket)
             try:
@@ -445,6 +455,7 @@ class FairGate:
             what,
             f"no {what} could start",
             queued=queued,
+            debt=self.ledger.describe(client),
         )
 
 
@@ -468,10 +479,11 @@ async def in_process(
     ``timing`` gets the seconds spent waiting for the gate ("gate") and in the thread ("thread"),
     for the answer's Server-Timing header: under a crowd, the two tell queueing from work."""
     t0 = time.perf_counter()
-    async with in_process_gate.turn(client_of(http), IN_PROCESS_START_SECONDS, what):
+    client = client_of(http)
+    async with in_process_gate.turn(client, IN_PROCESS_START_SECONDS, what):
         t1 = time.perf_counter()
-        try:
-            return await run_in_threadpool(fn, *args)
+        try:  # its thread's CPU time is charged to the client (mechanics/fair_share.py)
+            return await run_in_threadpool(thread_cpu, partial(fn, *args), client)
         finally:
             if timing is not None:
                 timing["gate"], timing["thread"] = t1 - t0, time.perf_counter() - t1

@@ -10,8 +10,10 @@ workers are forked from a clean single-threaded process that imported the engine
 server's listening socket.
 
 Admission is fair: a client (an address) has at most ``per_client`` jobs running; its further
-requests wait behind its own while everyone else's go first, in arrival order. Time spent waiting
-counts against a request's budget; one that cannot start within it is refused.
+requests wait behind its own while everyone else's go first, in arrival order. Fair over time too:
+each job's CPU time is charged to its client (mechanics/fair_share.py), clients in debt wait
+behind those with credit and may not take the last free worker. Time spent waiting counts against
+a request's budget; one that cannot start within it is refused.
 
 Nothing outlives the server: each worker watches a pipe whose only write end the server holds, and
 exits when it reads EOF (the server closed the pool, exited or was killed with SIGKILL).
@@ -50,6 +52,7 @@ from mechanics.budget import (
     portable,
     rebuild,
 )
+from mechanics.fair_share import LEDGER, CpuLedger, reserve_for
 
 __all__ = ["WorkerPool", "WorkerLost"]
 
@@ -85,8 +88,11 @@ class WorkerPool:
         per_client: int | None = None,
         memory_bytes: int = DEFAULT_MEMORY_BYTES,
         preload: Sequence[str] = ("mechanics.jobs",),
+        ledger: CpuLedger | None = None,
     ) -> None:
         self.size = max(1, size)
+        self.ledger = ledger or LEDGER
+        self.reserve = reserve_for(self.size)
         self.per_client = max(1, per_client or self.size // 2)
         self.memory_bytes = memory_bytes
         self._preload = list(preload)
@@ -170,27 +176,39 @@ class WorkerPool:
                 "was busy): try again shortly"
             )
         try:
-            return self._execute(slot, (fn, args, kwargs), deadline, seconds, what, advice)
+            job = (fn, args, kwargs)
+            return self._execute(slot, job, deadline, seconds, what, advice, client)
         finally:
             self._release(slot, client)
 
     def _execute(
-        self, slot: _Slot, job: tuple, deadline: float, seconds: float, what: str, advice: str
+        self,
+        slot: _Slot,
+        job: tuple,
+        deadline: float,
+        seconds: float,
+        what: str,
+        advice: str,
+        client: str = "",
     ) -> Any:
         payload = pickle.dumps((*job, self.memory_bytes), pickle.HIGHEST_PROTOCOL)
+        started = time.monotonic()
         try:
             conn = self._deliver(slot, payload)
             answered = conn.poll(max(0.0, deadline - time.monotonic()))
             if not answered:
                 slot.broken = True
+                self.ledger.charge(client, time.monotonic() - started)  # killed: its wall time
                 raise BudgetExceeded(
                     "time",
                     f"{what} took longer than {seconds:g} s; {advice}",
                 )
-            status, value, retire = pickle.loads(conn.recv_bytes())
+            status, value, retire, cpu = pickle.loads(conn.recv_bytes())
         except (EOFError, OSError) as exc:
             slot.broken = True
+            self.ledger.charge(client, time.monotonic() - started)
             raise WorkerLost(f"the process {what} stopped{self._exit_note(slot)}") from exc
+        self.ledger.charge(client, cpu)
         slot.broken = retire
         if status == "ok":
             return value
@@ -236,20 +254,25 @@ class WorkerPool:
                     remaining = deadline - time.monotonic()
                     if remaining <= 0:
                         raise BudgetExceeded("time", self._busy_message(client, seconds))
-                    self._cond.wait(remaining)
+                    # at least once a second: a client in debt earns credit back while it waits
+                    self._cond.wait(min(remaining, 1.0))
             finally:
                 self._waiting.remove((ticket, client))
                 self._cond.notify_all()  # the tickets behind this one may be eligible now
 
     def _grant(self, ticket: object, affinity: str | None) -> int | None:
-        """The slot this ticket gets now, or None: free slots go to waiting tickets in arrival
-        order, skipping the tickets whose client already has ``per_client`` jobs running."""
+        """The slot this ticket gets now, or None: free slots go to waiting tickets in the
+        ledger's order (clients with CPU credit first, in arrival order), skipping the tickets
+        whose client already has ``per_client`` jobs running, and those of clients in debt when
+        only the reserved slots are free."""
         free = len(self._free)
         running = Counter(self._running)
-        for waiting, client in self._waiting:
+        for waiting, client in self.ledger.ordered(self._waiting, key=lambda w: w[1]):
             if free == 0:
                 return None
             if running[client] >= self.per_client:
+                continue
+            if not self.ledger.may_take(client, free, self.reserve):
                 continue
             if waiting is ticket:
                 return self._choose(affinity)
@@ -266,6 +289,7 @@ class WorkerPool:
 
     def _busy_message(self, client: str, seconds: float) -> str:
         queued = sum(1 for _, c in self._waiting if c == client) - 1  # besides this one
+        debt = self.ledger.describe(client)
         return busy_message(
             self._running[client],
             self.per_client,
@@ -273,6 +297,7 @@ class WorkerPool:
             "request",
             "no worker was free",
             queued=max(0, queued),
+            debt=debt,
         )
 
     def _release(self, slot: _Slot, client: str) -> None:
@@ -347,18 +372,21 @@ def _worker_main(conn: Connection, lifeline: Connection) -> None:
 
 
 def _answer(request: bytes) -> tuple[bytes, bool]:
-    """Run one job under its memory cap: the pickled ("ok"|"error", value, retire) and retire.
+    """Run one job under its memory cap: the pickled ("ok"|"error", value, retire, CPU seconds)
+    and retire.
 
     A worker that ran out of memory retires after answering: whatever it half-built is gone with
     it, and the pool starts a fresh one.
     """
     memory_bytes = DEFAULT_MEMORY_BYTES
+    cpu = time.process_time()  # what the job cost, for its client's share (fair_share.py)
     try:
         fn, args, kwargs, memory_bytes = pickle.loads(request)
         limit_memory(memory_bytes)
         try:
             value = fn(*args, **kwargs)
-            return pickle.dumps(("ok", value, False), pickle.HIGHEST_PROTOCOL), False
+            reply = ("ok", value, False, time.process_time() - cpu)
+            return pickle.dumps(reply, pickle.HIGHEST_PROTOCOL), False
         finally:
             lift_memory_limit()
     except MemoryError:
@@ -367,10 +395,10 @@ def _answer(request: bytes) -> tuple[bytes, bool]:
             f"it needed more than {memory_bytes / 1024**3:g} GiB of memory; "
             "simplify it and try again",
         )
-        return pickle.dumps(("error", portable(error), True)), True
+        return pickle.dumps(("error", portable(error), True, time.process_time() - cpu)), True
     except BaseException as exc:  # everything, even SystemExit, goes back to the server
         exc.add_note("in the worker process:\n" + traceback.format_exc())
-        return pickle.dumps(("error", portable(exc), False)), False
+        return pickle.dumps(("error", portable(exc), False, time.process_time() - cpu)), False
 
 
 def _exit_with_server(lifeline: Connection) -> None:
@@ -398,11 +426,18 @@ def _exit_with_server(lifeline: Connection) -> None:
 
 
 def busy_message(
-    mine: int, per_client: int, seconds: float, what: str, busy: str, queued: int = 0
+    mine: int,
+    per_client: int,
+    seconds: float,
+    what: str,
+    busy: str,
+    queued: int = 0,
+    debt: str = "",
 ) -> str:
     """Why a job could not start in time, in words that tell the client what to do: its own
     queue (wait for its answers) or the server's (try again shortly). ``queued`` counts the
-    client's other jobs still waiting: ten sent at once read "1 running" while nine waited."""
+    client's other jobs still waiting: ten sent at once read "1 running" while nine waited.
+    ``debt`` says why a client past its share of CPU over time waits (fair_share.describe)."""
     if mine >= per_client:
         waiting = f" and {queued} more waiting" if queued else ""
         return (
@@ -410,4 +445,6 @@ def busy_message(
             f"{per_client} at a time){waiting}, and this one could not start within "
             f"{seconds:g} s; wait for the answers, then try again"
         )
+    if debt:  # CPU over time (mechanics/fair_share.py): the client's own use is the cause
+        return f"this {what} could not start within {seconds:g} s: {debt}; try again in a minute"
     return f"the server is busy: {busy} within {seconds:g} s; try again shortly"
