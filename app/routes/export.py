@@ -25,7 +25,7 @@ from fastapi.responses import RedirectResponse
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from app import derivations
+from app import derivations, share_links
 from app.errors import readable
 from app.routes.scenes import unknown_scene
 from app.routes.simulate import simulation_answer
@@ -37,6 +37,7 @@ from app.schemas import (
     SimulateRequest,
     ValidationErrors,
 )
+from mechanics.budget import BudgetExceeded
 from mechanics.export_formats import (
     json_text,
     spec_toml,
@@ -516,6 +517,11 @@ async def open_share(token: str, http: Request) -> RedirectResponse:
 
 
 async def _decoded(token: str, http: Request) -> ShareState:
+    """The state of a link, checked once per link and kept (app/share_links.py)."""
+    return await share_links.memo.get(token, lambda: _decode_and_check(token, http))
+
+
+async def _decode_and_check(token: str, http: Request) -> ShareState | share_links.Undecided:
     try:
         document = decode_state(token)
         state = ShareState.model_validate(document)
@@ -532,12 +538,22 @@ async def _decoded(token: str, http: Request) -> ShareState:
         raise HTTPException(
             422, [{"field": f"token.{p['field']}", "message": p["message"]} for p in problems]
         )
-    await _runnable(state, document, http, prefix="token.")
+    seconds = share_links.link_seconds(token, derivations.derive_seconds())
+    try:
+        await _runnable(state, document, http, prefix="token.", seconds=seconds)
+    except BudgetExceeded as exc:
+        if exc.kind != "time":
+            raise
+        return share_links.Undecided(state)  # cannot decide in time: the page's run will say
     return state
 
 
 async def _runnable(
-    state: ShareState, document: Mapping[str, Any], http: Request, prefix: str
+    state: ShareState,
+    document: Mapping[str, Any],
+    http: Request,
+    prefix: str,
+    seconds: float | None = None,
 ) -> None:
     """A 422 with /simulate's own fields and reasons when the run the page makes of this state
     would be refused (mechanics.export_share.run_problems): a built-in scene's checks in this
@@ -558,6 +574,7 @@ async def _runnable(
             request,
             affinity=key,
             what="checking the shared run",
+            seconds=seconds,
         )
     if problems:
         raise HTTPException(
