@@ -10,9 +10,11 @@ when asked (the routes call it for the assignment before reading scores).
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import os
-from collections import Counter, defaultdict
+import threading
+from collections import Counter, OrderedDict, defaultdict
 from collections.abc import Callable
 from typing import Any
 
@@ -145,6 +147,7 @@ def preview(store: Store, assignment_id: str) -> dict[str, Any]:
                 "parameters": v.variant.get("parameters", {}),
                 "switches": v.variant.get("switches", {}),
                 "keys": v.keys.get("parts", []),
+                "variant": v.variant,
             }
             for v in store.variants(assignment_id)
         ],
@@ -227,22 +230,25 @@ def submit(
     run: Run = local_run,
 ) -> dict[str, Any]:
     """Store the answer, then judge it and store its score; the stored row's JSON."""
-    row = _assignment(store, assignment_id)
+    row, chosen, done, recent = store.submit_context(assignment_id, student, part_id, 60)
+    if row is None:
+        raise Refused(404, "assignment_id", f"no assignment '{assignment_id}'")
     if row.closed:
         raise Refused(409, "assignment_id", "this assignment is closed")
-    chosen = store.variant_of(assignment_id, student)
+    if chosen is None:
+        chosen = store.variant_of(assignment_id, student)
     if chosen is None:
         raise Refused(409, "assignment_id", "this assignment has no deployable variant")
     part = next((p for p in chosen.variant["parts"] if p["id"] == part_id), None)
     if part is None:
         raise Refused(404, "part_id", f"no part '{part_id}' in this assignment")
     policy = _policy(row.template, part)
-    previous = [attempt_of(s) for s in store.attempts(assignment_id, student, part_id)]
+    previous = [attempt_of(s) for s in done]
     left = grading.attempts_left(previous, policy)
     if left == 0 and not any(a.answer.strip() == answer.strip() for a in previous):
         raise Refused(409, "answer", f"all {policy.max_attempts} attempts of this part are used")
     limit = submissions_per_minute()
-    if store.recent_submissions(student, 60) >= limit:
+    if recent >= limit:
         raise Refused(429, "answer", f"more than {limit} submissions in a minute; wait a little")
     stored, new = store.store_pending(assignment_id, student, part_id, answer, request_id)
     if not new and stored.status == "graded":
@@ -250,10 +256,40 @@ def submit(
     return _submission_json(_grade(store, stored, chosen.variant, part, policy, previous, run))
 
 
+#: Verdicts already reached, by (scene, quantity, coordinate, answer): a class types the same
+#: answers, and a verdict is a pure function of them (the engine's version is fixed per process).
+_verdicts: OrderedDict[tuple, dict] = OrderedDict()
+_verdicts_lock = threading.Lock()
+MAX_VERDICTS = 4096
+
+
+def _remembered(key: tuple, compute: Callable[[], dict]) -> dict:
+    with _verdicts_lock:
+        if key in _verdicts:
+            _verdicts.move_to_end(key)
+            return _verdicts[key]
+    verdict = compute()  # an exception (past the budget) is not remembered
+    with _verdicts_lock:
+        _verdicts[key] = verdict
+        while len(_verdicts) > MAX_VERDICTS:
+            _verdicts.popitem(last=False)
+    return verdict
+
+
+def forget_verdicts() -> None:
+    """Empty the verdict memo (tests that count how often the checker runs)."""
+    with _verdicts_lock:
+        _verdicts.clear()
+
+
 def _grade(store, stored, variant_json, part, policy, previous, run) -> Any:  # noqa: ANN001
     variant = Variant.from_json(variant_json)
 
     def budgeted(spec_text, quantity, coordinate, answer):  # noqa: ANN001, ANN202
+        key = (hashlib.sha256(spec_text.encode()).hexdigest(), quantity, coordinate, answer)
+        return _remembered(key, lambda: judge_in_pool(spec_text, quantity, coordinate, answer))
+
+    def judge_in_pool(spec_text, quantity, coordinate, answer):  # noqa: ANN001, ANN202
         return run(
             grading.judge_job,
             spec_text,

@@ -71,6 +71,8 @@ def attempt_of(row: SubmissionRow) -> Attempt:
 class Store:
     def __init__(self, engine: Engine | None = None) -> None:
         self.engine = engine or engine_for()
+        #: Variants never change once stored: kept by id after their first read.
+        self._variants: dict[int, VariantRow] = {}
 
     @contextmanager
     def session(self) -> Iterator[Session]:
@@ -150,7 +152,7 @@ class Store:
                     )
                 )
                 if enrolled is not None:
-                    return s.get(VariantRow, enrolled.variant_id)
+                    return self._variant(s, enrolled.variant_id)
             deployable = [v for v in self.variants(assignment_id) if v.deployable]
             if not deployable:
                 return None
@@ -166,6 +168,48 @@ class Store:
             except IntegrityError:
                 continue
         return None
+
+    def _variant(self, s: Session, variant_id: int) -> VariantRow | None:
+        row = self._variants.get(variant_id)
+        if row is None:
+            row = s.get(VariantRow, variant_id)
+            if row is not None:
+                self._variants[variant_id] = row
+        return row
+
+    @_reachable
+    def submit_context(
+        self, assignment_id: str, student: str, part: str, seconds: float
+    ) -> tuple[AssignmentRow | None, VariantRow | None, list[SubmissionRow], int]:
+        """What a submission needs, read in one transaction: the assignment, the student's
+        variant (None if not yet chosen), their graded attempts at the part, and how many
+        submissions they made in the last ``seconds``."""
+        since = datetime.now(UTC) - timedelta(seconds=seconds)
+        with self.session() as s:
+            assignment = s.get(AssignmentRow, assignment_id)
+            enrolled = s.scalar(
+                select(EnrolmentRow.variant_id).where(
+                    EnrolmentRow.assignment_id == assignment_id, EnrolmentRow.student == student
+                )
+            )
+            variant = None if enrolled is None else self._variant(s, enrolled)
+            attempts = s.scalars(
+                select(SubmissionRow)
+                .where(
+                    SubmissionRow.assignment_id == assignment_id,
+                    SubmissionRow.student == student,
+                    SubmissionRow.part == part,
+                    SubmissionRow.status == "graded",
+                )
+                .order_by(SubmissionRow.id)
+            )
+            attempts = list(attempts)
+            recent = s.scalar(
+                select(func.count(SubmissionRow.id)).where(
+                    SubmissionRow.student == student, SubmissionRow.created_at >= since
+                )
+            )
+            return assignment, variant, attempts, int(recent or 0)
 
     # -- submissions ---------------------------------------------------------------------------
     @_reachable

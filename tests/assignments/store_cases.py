@@ -29,6 +29,7 @@ RIGHT_V = "-m*g*l*cos(theta)"
 
 @pytest.fixture
 def store(url):
+    service.forget_verdicts()  # each case judges its answers afresh
     return Store(engine_for(url))
 
 
@@ -71,6 +72,19 @@ def test_a_restart_serves_the_same_variant_and_scores(deployed, url):
     again = Store(make_engine(url))  # a new engine: another server, or this one restarted
     assert service.student_view(again, "week1", "s1") == view
     assert first["score"] == 1.0 and view["parts"][0]["score"] == 1.0
+
+
+def test_the_same_answer_is_judged_once_for_a_class(deployed):
+    calls = []
+
+    def counted(job, *args, **kwargs):
+        calls.append(args)
+        return job(*args)
+
+    for student in ("m1", "m2", "m3"):
+        service.submit(deployed, "week1", student, "V", "m*g*l*cos(theta)", run=counted)
+    variants = {deployed.variant_of("week1", s).seed for s in ("m1", "m2", "m3")}
+    assert len(calls) == len(variants)  # once per variant, not once per student
 
 
 def test_the_answer_is_stored_before_it_is_judged(deployed):
