@@ -1,9 +1,9 @@
-"""The house keeps its shape: the engine"s stages import only the stages above them, modules and
+"""The house keeps its shape: the engine's stages import only the stages above them, modules and
 functions stay small, and test files are named after what they test (issue 25, and
 ../shared/ARCHITECTURE.md).
 
 The pipeline is `spec ← model ← derivation ← numerics ← {simulation, equilibria, answers} ← export
-← serving`. Until the engine is cut into one package per stage, each of today"s flat modules is
+← serving`. Until the engine is cut into one package per stage, each of today's flat modules is
 assigned to its stage in `STAGE`; a module moved into a stage package is found by its package name.
 What breaks a rule today is listed in `ALLOWED_*` below, one line each: the lists only shrink. A new
 module, function or import that breaks a rule fails here with the rule it breaks.
@@ -61,6 +61,8 @@ STAGE = {
     "export_share": "export",
     "export": "export",
     "cache": "serving",
+    "cache_disk": "serving",
+    "cache_redis": "serving",
     "pool": "serving",
     "budget": "serving",
     "jobs": "serving",
@@ -86,7 +88,6 @@ ALLOWED_UPWARD: set[tuple[str, str]] = {
 }
 #: Modules over 600 lines today.
 ALLOWED_LONG_MODULES: set[str] = {
-    "cache",
     "check",
     "equilibria",
     "expr",
