@@ -25,7 +25,7 @@ ORDER = ("spec", "model", "derivation", "numerics", "run", "export", "serving", 
 #: simulation, equilibria and answers are siblings below numerics: none imports another.
 SIBLINGS = {"simulation": "run", "equilibria": "run", "answers": "run"}
 
-#: Today"s flat modules (and stage packages once they exist) by stage. `tools` are the benchmarks
+#: Today's flat modules (and stage packages once they exist) by stage. `tools` are the benchmarks
 #: and the oracle, which ARCHITECTURE.md moves out of the engine (benchmarks/, tests/support/).
 STAGE = {
     "spec": "spec",
@@ -276,7 +276,7 @@ def test_engine_pieces_stay_small(kind, index, allowed):
 
 
 def test_a_module_over_400_lines_says_why():
-    """ARCHITECTURE.md: over 400 lines only with a one-line reason in the module"s docstring (one
+    """ARCHITECTURE.md: over 400 lines only with a one-line reason in the module's docstring (one
     that says how many "lines" and why)."""
     silent = set()
     for name, path in _modules().items():
@@ -290,8 +290,8 @@ def test_a_module_over_400_lines_says_why():
 
 
 def test_test_files_are_named_after_a_concept():
-    """No digits, "trust", "round", "leftovers" or "polish" in a test file"s name (2d/3d and a11y
-    are concepts); the round that found a bug goes in the test"s docstring."""
+    """No digits, 'trust', 'round', 'leftovers' or 'polish' in a test file's name (2d/3d and a11y
+    are concepts); the round that found a bug goes in the test's docstring."""
     named = set()
     for path in (ROOT / "tests").rglob("test_*.py"):
         stem = re.sub(r"a11y|[23]d", "", path.stem.removeprefix("test_"))
