@@ -56,6 +56,10 @@ lock goes without one (the computation raised) or their wait times out.
 
 Values are JSON (dicts, lists, strings, numbers); a caller gets the value as read back from its
 JSON whether it was computed or found, and must not change it (it may be shared in memory).
+
+Why about 430 lines: the stores, keys, the verification of an entry and single flight are one
+answer to "when is a stored value served"; where entries live is in mechanics/cache_disk.py and
+mechanics/cache_redis.py.
 """
 
 from __future__ import annotations
