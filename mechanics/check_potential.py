@@ -53,9 +53,14 @@ def missing_potential(judge: Any, given: sp.Expr, expected: sp.Expr) -> list[str
     motion_only = quantity in ("V", "L")  # there a constant difference is only the datum
     same = constant_proof if motion_only else zero_proof
     gap = judge.values(given - expected, motion_only)
+    memo: dict[sp.Expr, tuple[sp.Expr, list[complex]]] = {}  # each piece's effect, once
     for pieces in _candidates(judge, parts):
-        effects = [_effect(judge, piece) for _, piece in pieces]
-        marks = [judge.values(e, motion_only) for e in effects]
+        for _, piece in pieces:
+            if piece not in memo:
+                effect = _effect(judge, piece)
+                memo[piece] = (effect, judge.values(effect, motion_only))
+        effects = [memo[piece][0] for _, piece in pieces]
+        marks = [memo[piece][1] for _, piece in pieces]
         if not _fits(gap, marks, motion_only):
             continue
         if same(given - (expected - sp.Add(*effects)), m) is True:
