@@ -39,11 +39,13 @@ import numpy as np
 import sympy as sp
 from sympy.physics.vector import Vector
 
+from mechanics import equilibrium_branches as branches
 from mechanics import equilibrium_families as families_
 from mechanics import equilibrium_flat as flat
 from mechanics import equilibrium_stability as stability
 from mechanics.degenerate import check_mass_matrix
 from mechanics.derive import Derivation
+from mechanics.equilibrium_branches import Variant
 from mechanics.expr import parse, to_latex, to_plain
 from mechanics.model import T as t
 from mechanics.model import _inertia_errors
@@ -60,8 +62,6 @@ MAX_STARTS = 256
 MAX_NEWTON_STEPS = 60
 SEARCH_SECONDS = 3.0
 MAX_EQUILIBRIA = 24
-#: Springs along a line are derived on one side of their anchor; at most this many sides in all.
-MAX_BRANCH_VARIANTS = 8
 
 KINDS = ("stable", "asymptotically stable", "gyroscopically stable", "marginal", "unstable")
 STABLE_KINDS = frozenset(KINDS[:3])
@@ -147,15 +147,15 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     periods = _once(d, "periods", "", lambda: _periods(d))
     found: list[tuple[Derivation, Root]] = []
     everywhere = Variant(m, d.work.mass_matrix, d.work.forcing, [])
-    if len(_once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]) > 1:
+    if len(_once(d, "variants", (), lambda: branches.variants(m, everywhere, ()))[0]) > 1:
         # the step shows every side's conditions as derived, whatever is 0 at these values, in
         # place of the general ones (which are the first side's, shown twice with and without
         # its label)
         del steps[0].lines[-len(m.q) :]
-        for variant in _once(d, "variants", (), lambda: _variants(d, everywhere, ()))[0]:
+        for variant in _once(d, "variants", (), lambda: branches.variants(m, everywhere, ()))[0]:
             conds = _once(d, "at rest", ((), variant.label), functools.partial(_at_rest, variant))
             steps[0].lines += _condition_lines(d, conds, f" ({variant.label})")
-    variants, notes = _once(d, "variants", zeros, lambda: _variants(d, base, zeros))
+    variants, notes = _once(d, "variants", zeros, lambda: branches.variants(m, base, zeros))
     warnings += notes
     idle = _idle_at(m, [_drop_idle_drive(d, c, values) for c in general], values)
     families: list[str] = []
@@ -259,6 +259,9 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             )
             continue
         verdict.family = root.family or verdict.family
+        if variant.ranges and (meaning := branches.meaning(m, q0, values)):
+            # a spring passed through its anchor, two masses through each other: said first
+            verdict.reason = f"{meaning}. {verdict.reason[:1].upper()}{verdict.reason[1:]}"
         verdicts.append(verdict)
         results.append(_result_json(m, root, free, verdict, q0))
         continua.add(q0, verdict, results[-1])
@@ -863,59 +866,6 @@ def _same(a: dict[int, float], b: dict[int, float], periods: dict[int, float]) -
         if abs(diff) > 1e-6 * (1 + abs(x)):
             return False
     return True
-
-
-# --- springs along a line: both sides of the anchor ------------------------------------------
-
-
-@dataclass
-class Variant:
-    """The equations with each spring along a line on one side of its anchor.
-
-    Such a spring is derived as ℓ = p without |·|, valid while p > 0: an equilibrium on the other
-    side (x = −ℓ₀) solves the equations with ℓ = −p. ½k(−p − ℓ₀)² − ½k(p − ℓ₀)² = 2kℓ₀p, so that
-    variant's forcing is f − 2kℓ₀ ∂p/∂q, valid while −p > 0: no new derivation is needed."""
-
-    model: Any
-    mass_matrix: sp.Matrix
-    forcing: sp.Matrix
-    ranges: list[sp.Expr]
-    label: str = ""
-
-
-def _variants(d: Derivation, base: Variant, zeros: tuple) -> tuple[list[Variant], list[str]]:
-    """Every side of every spring's anchor (bounded), with a note when not all were searched.
-
-    A spring whose rest length is 0 here has no sides: ½k p² is smooth through its anchor, where
-    it rests when nothing else pulls (its range p > 0 had left that equilibrium out); nor has a
-    spring of stiffness 0, which pulls on nothing."""
-    m = d.model
-    to_zero = {p: sp.S.Zero for p in zeros}
-    springs = [  # with k = 0 a spring exerts nothing: its side does not matter either
-        s
-        for s in m.springs
-        if getattr(s, "branch", None) is not None
-        and s.rest_length.xreplace(to_zero) != 0
-        and s.k.xreplace(to_zero) != 0
-    ]
-    variants, warnings = [], []
-    for flips in itertools.product((False, True), repeat=len(springs)):
-        if len(variants) >= MAX_BRANCH_VARIANTS:
-            warnings.append(
-                "Many springs lie along lines: only some sides of their anchors were searched "
-                "for equilibria."
-            )
-            break
-        forcing, ranges, where = base.forcing, [], []
-        for s, flip in zip(springs, flips, strict=True):
-            p = -s.branch if flip else s.branch
-            if flip:
-                extra = 2 * s.k * s.rest_length * sp.Matrix([s.branch.diff(q) for q in m.q])
-                forcing = forcing - extra
-            ranges.append(p)
-            where.append(f"{s.name}: ℓ = {to_plain(p)}")
-        variants.append(Variant(m, base.mass_matrix, forcing, ranges, ", ".join(where)))
-    return variants, warnings
 
 
 # --- the roots: closed form, checked and completed by a numeric search -----------------------
@@ -1992,8 +1942,8 @@ def _stability(
     idx = [j for j in range(n) if abs(full_M[j, j]) > 1e-12 * inertia]
     if not idx:  # the coordinates are singular here (∂r/∂q = 0), the body is not weightless
         forces = _rest_force_function(*(tuple(x) for x in (v.forcing, m.q, m.qd, m.qdd)), psyms)
-        kind, reason = flat.singular_point(at_rest, forces, q0, numbers if at_rest else [])
-        return Verdict(kind, reason, [], [], [], [], None, pole=True)
+        kind, reason, check = flat.singular_point(at_rest, forces, q0, numbers if at_rest else [])
+        return Verdict(kind, reason, [], [], [], [], None, pole=check)
     if at_rest is not None and _singular(full_M[np.ix_(idx, idx)], 1e-12):
         idx = _off_the_pole(at_rest, full_M, q0, numbers, idx)
     K = K_.reshape(n, n)[np.ix_(idx, idx)]

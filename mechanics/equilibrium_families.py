@@ -15,7 +15,6 @@ orientation is not in its position).
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -23,25 +22,6 @@ import sympy as sp
 
 #: Members whose distances agree to this (relative) belong to one family.
 _SAME = 1e-6
-
-
-def positions(m: Any, q0: list[float], values: dict) -> dict[str, np.ndarray] | None:
-    """Every named place (bodies, points) at q0 and t = 0, as 3-vectors; None where one is not
-    a number (then nothing is grouped)."""
-    at = {**values, **{q: sp.Float(x) for q, x in zip(m.q, q0, strict=True)}}
-    at[m.names["t"]] = sp.S.Zero
-    out = {}
-    anchored = {"O"} & {x for s in m.springs for x in (s.a, s.b)}
-    for name, r in m.positions.items():
-        if name == "O" and not anchored:
-            continue  # the origin is no place of the scene unless a spring is tied to it
-        try:
-            out[name] = np.array(
-                [float(sp.S.Zero + c.xreplace(at)) for c in r.to_matrix(m.N)], dtype=float
-            )
-        except (TypeError, ValueError):
-            return None
-    return out
 
 
 def _distances(places: dict[str, np.ndarray]) -> tuple[float, ...]:
@@ -155,15 +135,3 @@ class Continua:
                 + ", ".join(f"{k} = {x:.4g}" for k, x in result["q"].items())
                 + f", and every point of it has the same verdict ({v.kind})."
             )
-
-
-def gap(a: dict[int, float], b: dict[int, float], periods: dict[int, float]) -> float:
-    """The largest relative difference of two points' coordinates (angles modulo their
-    period)."""
-    out = 0.0
-    for j in set(a) | set(b):
-        diff = a.get(j, 0.0) - b.get(j, 0.0)
-        if j in periods:
-            diff = math.remainder(diff, periods[j])
-        out = max(out, abs(diff) / max(1.0, abs(a.get(j, 0.0))))
-    return out

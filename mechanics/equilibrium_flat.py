@@ -41,7 +41,7 @@ def flat_report(
 ) -> FlatReport | None:
     """The higher-order test along every flat direction of K among the coordinates ``keep``
     (the non-free ones); None when K has none (the linear test decides)."""
-    flat, stiff = stability.flat_directions(K, keep)
+    flat, stiff = stability.flat_directions(M, K, keep)
     if not flat.shape[1]:
         return None
     kappa = max(float(np.max(np.abs(K))), 1e-300)
@@ -97,7 +97,7 @@ def amend(
     where = _direction(report.directions[:, report.shapes.index(f)], names)
     flat = (
         f"$\\mathbf K$ is singular along ${where}$ (the quadratic part of the {potential} "
-        "vanishes there, so the linear test alone cannot decide); the higher-order test, with "
+        "vanishes there, so the linear test alone is silent); the higher-order test, with "
         "the other coordinates at their balance, "
     )
     if f.shape == "rises":
@@ -179,13 +179,19 @@ def singular_point(
     forces: Callable[..., list] | None,
     q0: list[float],
     numbers: list[float],
-) -> tuple[str, str]:
-    """The verdict where the mass matrix vanishes (∂r/∂q = 0: the cusp of a cycloid, x = s³):
-    the coordinates are singular, not the body weightless, and the linearization says nothing.
-    In the configuration itself the potential still decides where it rises on both sides of a
-    one-coordinate point (E = T + V with T ≥ 0 keeps V below its start: Lagrange–Dirichlet
-    needs no inertia). Otherwise: no verdict, with the reason. Never 'stable because no
-    coordinate carries inertia' (the cusp at the top of a cycloid is a maximum of V)."""
+) -> tuple[str, str, bool]:
+    """The verdict where the mass matrix vanishes (∂r/∂q = 0: the cusp of a cycloid, x = s³),
+    and whether the caller must still check that the forces vanish beside the point.
+
+    The coordinates are singular there, not the body weightless, and the linearization says
+    nothing. In the configuration the potential still decides for one coordinate: where it
+    rises on both sides (a smooth minimum, or the notch of a cusp pointing down, where the force
+    along the wire points into the cusp from both sides) E = T + V with T ≥ 0 keeps the motion
+    in the well: stable (Lagrange–Dirichlet needs no inertia). Where it falls on a side, a body
+    released there at rest runs away: unstable, if the point is an equilibrium at all (at the
+    cusp at the top of a cycloid's arch gravity pulls along the vertical wire right up to it:
+    not one, which the caller's check finds). Otherwise no verdict, with the reason. Never
+    'stable because no coordinate carries inertia'."""
     head = (
         f"{SINGULAR}: the mass matrix vanishes, because the position does not move to first "
         "order in the coordinates ($\\partial \\mathbf r/\\partial q = 0$, a cusp or a "
@@ -193,26 +199,44 @@ def singular_point(
         "the linearization says nothing"
     )
     if at_rest is None or forces is None or len(q0) != 1:
-        return "marginal", head + "; no verdict in these coordinates"
-    n = len(q0)
+        return "marginal", head + "; no verdict in these coordinates", False
     base = np.asarray(q0, dtype=float)
 
     def force(x: np.ndarray) -> np.ndarray:
-        return np.array(forces(*x, *numbers), dtype=float).reshape(n)
+        return np.array(forces(*x, *numbers), dtype=float).reshape(1)
 
     def stiffness(x: np.ndarray) -> np.ndarray:
-        return np.array(at_rest(*x, *numbers)[1], dtype=float).reshape(n, n)
+        return np.array(at_rest(*x, *numbers)[1], dtype=float).reshape(1, 1)
 
     with np.errstate(all="ignore"):
         shape = stability.along_flat(force, stiffness, base, np.ones(1), np.zeros((1, 0)), 1.0, 0.0)
     if shape.shape == "rises":
-        return "stable", head + (
-            f"; but the potential rises on both sides{_power_words(shape.order)}, a strict "
-            "minimum in the configuration, and E = T + V with T ≥ 0 keeps the motion below "
-            "the energy it starts with: stable (Lagrange–Dirichlet needs no inertia)"
+        return (
+            "stable",
+            head
+            + (
+                "; but along the path the potential rises on both sides"
+                f"{_power_words(shape.order)} (a minimum in the configuration, or a notch where "
+                "the force points into the point from both sides), and E = T + V with T ≥ 0 keeps "
+                "the motion below the energy it starts with: stable (Lagrange–Dirichlet needs no "
+                "inertia)"
+            ),
+            False,
         )
-    what = {
-        "falls": "the potential has no minimum here (it falls beside the point)",
-        "level": "no force acts beside the point either",
-    }.get(shape.shape, "the higher-order test cannot tell the potential's shape here")
-    return "marginal", head + f"; {what}: the coordinate is singular here, so no verdict"
+    if shape.shape == "falls":
+        return (
+            "unstable",
+            head
+            + (
+                "; along the path the potential falls beside the point"
+                f"{_power_words(shape.order)}, so released there at rest the body runs away, and "
+                "cannot come back past the higher potential: unstable"
+            ),
+            True,
+        )
+    what = (
+        "no force acts beside the point either"
+        if shape.shape == "level"
+        else "the higher-order test cannot tell the potential's shape here"
+    )
+    return "marginal", head + f"; {what}: the coordinate is singular here, so no verdict", False

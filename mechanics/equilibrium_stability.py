@@ -60,18 +60,25 @@ def conservative_eigenvalues(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, 
     return lam, vecs
 
 
-def flat_directions(K: np.ndarray, keep: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """The directions (unit columns, over the coordinates ``keep``) along which the symmetric
-    part of K vanishes to round-off, and the stiff ones beside them."""
-    k = (K + K.T) / 2
-    sub = k[np.ix_(keep, keep)] if keep else np.zeros((0, 0))
-    if not sub.size:
-        return np.zeros((len(K), 0)), np.zeros((len(K), 0))
-    w, v = np.linalg.eigh(sub)
-    size = max(float(np.max(np.abs(w))), 1e-300)
-    flat = np.abs(w) <= 1e-9 * max(size, 1.0)
-    full = np.zeros((len(K), len(keep)))
-    full[keep, :] = v
+def flat_directions(M: np.ndarray, K: np.ndarray, keep: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The directions (columns over all coordinates, moving only those in ``keep``) along which
+    the symmetric part of K vanishes to round-off, and the stiff ones beside them. K is judged
+    per unit of inertia (L⁻¹ K L⁻ᵀ with M = L Lᵀ), as the linear test judges it: a light bob's
+    small m₂ g l is no flat direction because it is small beside m₁ g l."""
+    n = len(K)
+    if not keep:
+        return np.zeros((n, 0)), np.zeros((n, 0))
+    k = ((K + K.T) / 2)[np.ix_(keep, keep)]
+    mass = ((M + M.T) / 2)[np.ix_(keep, keep)]
+    try:
+        inverse = np.linalg.inv(np.linalg.cholesky(mass))
+    except np.linalg.LinAlgError:
+        inverse = np.eye(len(keep))
+    w, v = np.linalg.eigh(inverse @ k @ inverse.T)
+    flat = np.abs(w) <= 1e-9 * max(float(np.max(np.abs(w))), 1.0)
+    full = np.zeros((n, len(keep)))
+    full[keep, :] = inverse.T @ v  # back to displacements of the coordinates
+    full /= np.maximum(np.max(np.abs(full), axis=0), 1e-300)
     return full[:, flat], full[:, ~flat]
 
 
