@@ -110,7 +110,7 @@ class DiskBackend:
             os.replace(tmp, folder / f"{key}.entry")  # atomic: readers see all or nothing
             tmp = None
         except OSError as exc:
-            _failed(f"a {s.name} entry", exc)
+            _failed(f"an entry of {s.name}", exc)
             return
         finally:
             if tmp is not None:
@@ -154,7 +154,7 @@ class DiskBackend:
                 _unlink(lock)
                 continue
             except OSError as exc:
-                _failed(f"a {s.name} lock", exc)
+                _failed(f"a lock of {s.name}", exc)
                 return token
             return token
         return None
