@@ -33,7 +33,7 @@ from mechanics.check_identities import (  # noqa: F401  (re-exported: the proofs
 )
 from mechanics.check_identities import expansion_size as _expansion_size
 from mechanics.check_potential import missing_potential
-from mechanics.check_slips import sign_in_group
+from mechanics.check_slips import sign_in_group, sign_of_a_term
 from mechanics.derive import Derivation
 from mechanics.expr import parse
 from mechanics.expr import to_latex as _latex_of
@@ -1390,6 +1390,8 @@ class _Judge:
         else:
             paired = self._paired(given)
             terms = self._terms(given, expected) if paired is None else paired
+            if not any(line.startswith("Sign error") for line in terms):  # in the typed terms
+                terms = sign_of_a_term(self, expected) or terms
             slips = self._slips(given, expected)
             if terms and all(line.startswith("Sign error") for line in terms):
                 # (m₂ − m₁) g for (m₁ − m₂) g is the swap and the sign error at once: one story

@@ -58,6 +58,24 @@ def sign_in_group(judge: Any, expected: sp.Expr, fb: list[str]) -> bool:
     return False
 
 
+def sign_of_a_term(judge: Any, expected: sp.Expr) -> list[str]:
+    """One term of the answer, as the student wrote it, whose sign flipped makes the answer
+    right (m₁ g l₁ sin θ₁ − m₂ g l₁ sin θ₁ for (m₁ + m₂) g l₁ sin θ₁): named by that term, not
+    by the derived term it merges into. [] when no single term does (proved, as for brackets)."""
+    terms = sp.Add.make_args(judge.given)
+    if not 1 < len(terms) <= MAX_TRIES:
+        return []
+    for term in terms:
+        if _right(judge, judge.given - 2 * term, expected):
+            moved = judge._moved_term(term)
+            return [
+                f"Sign error in your term {judge._show(term)}{moved}: it should be "
+                f"{judge._show(-term)}. With that one sign changed, the rest of your answer "
+                "is right."
+            ]
+    return []
+
+
 def _brackets(text: str) -> list[tuple[int, int]]:
     """(start, end) of the inside of every balanced (…) in ``text``, innermost first."""
     spans, stack = [], []

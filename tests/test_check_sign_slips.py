@@ -179,3 +179,40 @@ def test_no_slip_is_claimed_where_one_sign_does_not_make_it_right(
 def test_the_right_answer_with_brackets_stays_right(scene, quantity, coordinate, answer):
     v = check(derivation_of_scene(scene), quantity, answer, coordinate)
     assert v.correct is True, v.feedback
+
+
+@pytest.mark.parametrize(
+    ("scene", "quantity", "coordinate", "answer", "typed"),
+    [
+        # (m₁ + m₂) g l₁ sin θ₁ written out as two terms, one with its sign flipped
+        (
+            "double_pendulum",
+            "eom",
+            "theta1",
+            "(m1+m2) l1^2 theta1'' + m2 l1 l2 cos(theta1 - theta2) theta2''"
+            " + m2 l1 l2 sin(theta1 - theta2) theta2'^2"
+            " + m1 g l1 sin(theta1) - m2 g l1 sin(theta1) = 0",
+            r"- g l_{1} m_{2} \sin{\left(\theta_{1} \right)}",
+        ),
+        (
+            "double_pendulum",
+            "T",
+            None,
+            f"m1/2 l1^2 theta1'^2 - m2/2 l1^2 theta1'^2 + m2/2 l2^2 theta2'^2 + {CROSS}",
+            r"- \frac{l_{1}^{2} m_{2} \dot{\theta}_{1}^{2}}{2}",
+        ),
+        (
+            "cart_pendulum",
+            "T",
+            None,
+            "M/2 x'^2 - m/2 x'^2 + m l x' theta' cos(theta) + 1/2 m l^2 theta'^2",
+            r"- \frac{m \dot{x}^{2}}{2}",
+        ),
+    ],
+)
+def test_a_sign_slip_in_a_written_out_coefficient_names_the_students_term(
+    scene, quantity, coordinate, answer, typed
+):
+    fb = feedback(scene, quantity, answer, coordinate)
+    assert fb[0].startswith(f"Sign error in your term ${typed}$"), fb
+    assert not any("has the coefficient" in line for line in fb), fb
