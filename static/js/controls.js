@@ -4,11 +4,23 @@
 import { nameText } from "./texnames.js";
 const SETTINGS = ["method", "method_b", "tol", "atol", "dt", "t_end", "compare", "lecture", "phase"];
 
-/** A sensible slider range for a value: [0, 3x] for a positive parameter, ±π for an angle. */
-export function sliderRange(value, { angle = false, positive = false } = {}) {
+/** Units of a quantity that is never 0 nor negative: a mass, a length, a moment of inertia. */
+const STRICTLY_POSITIVE = new Set(["kg", "m", "kg*m^2", "kg m^2", "kg·m²"]);
+
+/** Whether a parameter in `unit` must stay above 0 (a mass, a length): its slider then starts at
+ * a small positive value, since m = 0 or l = 0 makes every run fail and greys every panel
+ * (issue 26, item 5). A number box still takes any value (and the server names what is wrong). */
+export function mustBePositive(unit) {
+  return STRICTLY_POSITIVE.has(String(unit || "").trim());
+}
+
+/** A sensible slider range for a value: [0, 3x] for a positive parameter ([x/100, 3x] for one
+ * that must stay above 0: a mass, a length), ±π for an angle. */
+export function sliderRange(value, { angle = false, positive = false, strict = false } = {}) {
   let lo, hi;
   const a = Math.abs(value);
   if (angle) [lo, hi] = [-Math.PI, Math.PI];
+  else if (strict && value > 0) [lo, hi] = [value / 100, 3 * a];
   else if (positive) [lo, hi] = [0, a > 0 ? 3 * a : 2];
   else if (a === 0) [lo, hi] = [-2, 2];
   else [lo, hi] = [-3 * a, 3 * a];
@@ -84,7 +96,7 @@ function showNumber(number, value) {
 export function buildControls(box, rows, onChange, onCommit = () => {}) {
   box.replaceChildren();
   for (const { name, value, unit, angle, positive } of rows) {
-    const [lo, hi] = sliderRange(value, { angle, positive });
+    const [lo, hi] = sliderRange(value, { angle, positive, strict: positive && mustBePositive(unit) });
     const row = document.createElement("div");
     row.className = "control";
     row.innerHTML = `<label for="n-${name}"><span class="name"></span> <span class="unit"></span></label>
@@ -124,8 +136,10 @@ export function buildControls(box, rows, onChange, onCommit = () => {}) {
   }
 }
 
-/** Show a value in a control without firing its change (a button set it). */
+/** Show a value in a control without firing its change (a button set it); said on the document
+ * as `control-set` (lecture mode's strip, strip.js, shows it too). */
 export function setControl(name, value) {
+  document.dispatchEvent(new CustomEvent("control-set", { detail: { name, value } }));
   const slider = document.getElementById(`s-${name}`);
   const number = document.getElementById(`n-${name}`);
   if (number) showNumber(number, value);

@@ -174,34 +174,16 @@ export class Stage {
     });
     const turn = this.placeable() ? ["drag a body to place it,", "drag elsewhere to turn the view"] : ["drag to turn the view"];
     const note = g.is3D ? turn : this.follow ? ["camera follows the motion"] : [];
-    // on a white ground (halo), drawn last: a trail or a body under it does not cross it
-    this.#noteLines(note, font).forEach((text, k) => shapes.push({ t: "text", at: [10, 8 + font + k * 1.3 * font], text, color: "#868e96", size: font, halo: true }));
+    // the hint is a line under the canvas (access.js), never drawn over the motion: a 3-D one
+    // covered a third of a 374×247 canvas in lecture mode (issue 26, item 2)
+    const hint = note.join(" ");
+    if (canvas.dataset.hint !== hint) canvas.dataset.hint = hint;
     drawCanvas(ctx, shapes);
     canvas.dataset.frame = String(this.frame);
     const v = this.view; // the camera, for tests that check where things are drawn
     canvas.dataset.camera = JSON.stringify({ w: v.w, h: v.h, scale: v.scale, center: v.center, yaw: v.yaw, pitch: v.pitch, camera: v.camera, is3D: v.is3D });
     canvas.dataset.pieces = [...new Set(shapes.map((s) => s.piece).filter(Boolean))].sort().join(" ");
     if (this.instruments) this.instruments.update(this.frame);
-  }
-
-  /** The canvas note in one line where it fits, else a line per phrase, a phrase wider than the
-   * canvas broken between words (lecture mode's 24 px type cut "drag elsewhere to turn the v" at
-   * 1024 px). Measured once per text and size: measuring text every frame costs a drag its 60 fps. */
-  #noteLines(note, font) {
-    const key = `${this.cssW}|${font}|${note.join("|")}`;
-    if (this.noteKey !== key) {
-      this.ctx.font = `500 ${font}px system-ui, sans-serif`;
-      const fits = (text) => this.ctx.measureText(text).width <= this.cssW - 20;
-      const one = note.join(" ");
-      this.noteKey = key;
-      this.noteCache = fits(one) ? [one] : note.flatMap((phrase) => phrase.split(" ").reduce((lines, word) => {
-        const last = lines.length ? `${lines[lines.length - 1]} ${word}` : word;
-        if (lines.length && fits(last)) lines[lines.length - 1] = last;
-        else lines.push(word);
-        return lines;
-      }, []));
-    }
-    return this.noteCache;
   }
 
   #drag(e) {

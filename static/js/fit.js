@@ -148,9 +148,13 @@ function pack(parts, lines) {
   return rows.map((r) => r.join(" "));
 }
 
-/** `lhs &= rows[0] \\ &\quad rows[1] …` for an aligned block. */
+/** `lhs &= rows[0] \\ &\quad rows[1] …` for an aligned block; with `left` (a column too narrow
+ * for the left side's width on every row: lecture mode at 1024 px) every row starts at the left
+ * edge, the left side on a row of its own: `&lhs = \\ &\quad rows[0] \\ &\quad rows[1] …`. */
+let left = false;
 function alignedRows(lhs, parts, lines) {
   const rows = pack(parts, Math.min(lines, parts.length));
+  if (left) return [`&${lhs} =`, ...rows.map((r) => `&\\quad ${r}`)];
   return rows.map((r, k) => (k === 0 ? `${lhs} &= ${r}` : `&\\quad ${r}`));
 }
 
@@ -158,7 +162,16 @@ function alignedRows(lhs, parts, lines) {
  * The line `tex` broken into about `lines` lines (a LaTeX `aligned` block), or null when it has
  * nothing to break at. Exported for the tests.
  */
-export function breakLine(tex, lines, fine = false) {
+export function breakLine(tex, lines, fine = false, flush = false) {
+  left = flush;
+  try {
+    return breakAt(tex, lines, fine);
+  } finally {
+    left = false;
+  }
+}
+
+function breakAt(tex, lines, fine) {
   const eq = topLevel(tex, "=");
   if (!eq.length) {
     const parts = pieces(tex, fine);
@@ -194,7 +207,7 @@ export function breakLine(tex, lines, fine = false) {
     }));
   } else if (fraction && fraction[0].length > 2 * fraction[1].length / 3) {
     const [num, den] = fraction;
-    out.push(`${lhs} &= \\frac{\\text{num}}{\\text{den}}`);
+    out.push(left ? `&${lhs} = \\frac{\\text{num}}{\\text{den}}` : `${lhs} &= \\frac{\\text{num}}{\\text{den}}`);
     const numParts = pieces(num, fine), denParts = pieces(den, fine);
     const share = Math.max(1, lines - 1);
     out.push(...alignedRows("\\text{num}", numParts, Math.ceil((share * num.length) / (num.length + den.length))));
@@ -224,7 +237,8 @@ const fitted = new WeakMap();
 async function fitOne(box) {
   const node = box.querySelector("mjx-container");
   if (!box.clientWidth || !node) return; // not typeset yet: measured when it is
-  if (box.dataset.fitWidth === String(box.clientWidth) && fitted.get(box) === node) return;
+  const mode = inLecture() ? "lecture" : "page";
+  if (box.dataset.fitWidth === String(box.clientWidth) && box.dataset.fitMode === mode && fitted.get(box) === node) return;
   const original = box.dataset.latex;
   box.classList.remove("scrolls", "scaled");
   box.removeAttribute("tabindex");
@@ -234,13 +248,17 @@ async function fitOne(box) {
     await show(box, original);
     delete box.dataset.broken;
   }
-  // a little too wide is only scaled; much too wide is broken into lines first
-  if (original && overflows(box) && width / box.scrollWidth < 0.85) {
+  // a little too wide is only scaled; much too wide is broken into lines first. In lecture mode
+  // nothing is scaled below the room's 24 px (49 of 202 lecture screens showed 19.7 px): any
+  // equation too wide is broken, into as many lines as it takes (issue 26, item 2)
+  const lecture = inLecture();
+  if (original && overflows(box) && (lecture || width / box.scrollWidth < 0.85)) {
     const need = Math.ceil(box.scrollWidth / width);
     const tries = [[need, false], [need + 1, false], [need + 1, true], [need + 2, true], [need + 4, true]];
+    if (lecture) tries.push([need + 6, true], [need + 9, true], [need + 14, true], [need + 14, true, true]);
     let tried = null;
-    for (const [lines, fine] of tries) {
-      const broken = breakLine(original, lines, fine);
+    for (const [lines, fine, flush] of tries) {
+      const broken = breakLine(original, lines, fine, flush);
       if (!broken || broken === tried) continue;
       tried = broken;
       await show(box, broken);
@@ -250,13 +268,23 @@ async function fitOne(box) {
   }
   scaleOrScroll(box);
   box.dataset.fitWidth = String(box.clientWidth);
+  box.dataset.fitMode = mode;
   fitted.set(box, box.querySelector("mjx-container"));
 }
 
-/** Shrink an equation a little to fit, else mark its box as scrolling (with the cue). */
+/** Lecture mode: its 24 px type is the least the back of a hall reads (lecture.js sets it). */
+const inLecture = () => document.documentElement.classList.contains("lecture");
+
+/** Shrink an equation a little to fit (never in lecture mode), else mark its box as scrolling
+ * (with the cue). */
 function scaleOrScroll(box) {
   const svg = box.querySelector("mjx-container > svg");
   if (!overflows(box)) return;
+  if (inLecture()) { // never below the room's size: it scrolls in its own box instead
+    box.classList.add("scrolls");
+    box.tabIndex = 0;
+    return;
+  }
   // a few pixels of slack: a centred equation's edge lands on fractional pixels
   const scale = (box.clientWidth - 4) / box.scrollWidth;
   for (const s of [scale, scale * 0.97]) {

@@ -105,6 +105,28 @@ function accuracy(st) {
   return ["energy-balance error |ΔE − W_NC| / max T", st.energy_balance_error];
 }
 
+/** A run's accuracy as a reader takes it: the number, or, for a run whose energy went off by more
+ * than its own kinetic-energy scale (an error of 1 and more is no accuracy: the motion blew up),
+ * "blew up at t = …" from the first sample where it did (issue 26, item 5); where the run carries
+ * no energies to find that instant, it says it cannot tell when. */
+export function accuracyText(r) {
+  const [, value] = accuracy(r.stats);
+  const stop = r.stats.stop;
+  if (value === null || value === undefined || (Number.isFinite(value) && value < 1)) return fmt(value, 2);
+  const e = r.energy || {};
+  const E = e.E || [], T = e.T || [], W = e.W_nc || [], D = e.W_drive || [];
+  const scale = Math.max(...T.map((x) => Math.abs(x)).filter(Number.isFinite), 0);
+  let at = null;
+  if (E.length && scale > 0) {
+    const off = (i) => Math.abs(E[i] - E[0] - (r.stats.energy_error != null ? 0 : (W[i] || 0) + (D[i] || 0)));
+    const i = E.findIndex((x, k) => !Number.isFinite(x) || off(k) >= scale);
+    if (i >= 0) at = r.t[i];
+  }
+  const end = stop ? ` (then stopped at t = ${fmt(stop.t, 3)} s)` : "";
+  if (at === null) return `blew up (error ${fmt(value, 2)}; cannot tell when: no energies sampled)`;
+  return `blew up at t = ${fmt(at, 3)} s${end}`;
+}
+
 /** The cost and accuracy readout: one column per run. */
 export function showStats(runs) {
   const table = $("stats");
@@ -115,12 +137,12 @@ export function showStats(runs) {
     ["wall time", (r) => `${fmt(r.stats.wall_time * 1e3, 3)} ms`],
     ["steps", (r) => r.stats.steps.toLocaleString("en")],
     ["RHS evaluations", (r) => r.stats.rhs_evaluations.toLocaleString("en")],
-    [accuracy(runs[0].stats)[0], (r) => fmt(accuracy(r.stats)[1], 2)],
+    [accuracy(runs[0].stats)[0], accuracyText],
   ];
   for (const k of Object.keys(runs[0].stats.momentum_drift || {})) {
     rows.push([`p_${k} drift`, (r) => fmt((r.stats.momentum_drift || {})[k], 2)]);
   }
-  rows.push(["status", (r) => r.stats.status]);
+  rows.push(["status", (r) => (r.stats.stop ? `stopped at t = ${fmt(r.stats.stop.t, 3)} s` : r.stats.status)]);
   const head = runs.length > 1 ? `<tr><th></th><th>A</th><th>B</th></tr>` : "";
   table.innerHTML = `<thead>${head}</thead><tbody></tbody>`;
   const body = table.querySelector("tbody");
@@ -133,6 +155,7 @@ export function showStats(runs) {
       const td = document.createElement("td");
       td.textContent = String(get(r));
       if (label === "status" && r.stats.status !== "ok") td.className = "bad";
+      if (td.textContent.startsWith("blew up")) td.className = "bad";
       tr.append(td);
     }
     body.append(tr);

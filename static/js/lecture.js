@@ -73,6 +73,7 @@ export class Lecture {
   }
 
   #key(e) {
+    if (e.defaultPrevented) return; // taken already (the focused canvas's arrow keys: access.js)
     const t = e.target;
     if (t instanceof Element && t.closest("input, textarea, select, [contenteditable]")) return;
     if (e.ctrlKey || e.metaKey || e.altKey) return;

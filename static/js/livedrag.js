@@ -173,6 +173,35 @@ export class BodyDrag {
     this.canvas.addEventListener("pointercancel", up);
   }
 
+  /** The keyboard's drag (access.js, WCAG 2.5.7): `body` moved by (dx, dy) screen pixels, dropped
+   * from rest, as a pointer drag would move it; the server's run of the new start follows. The
+   * first press starts from where the body is drawn; presses after it from the start they set
+   * (the animation is paused meanwhile, so the body stays where the keys put it). */
+  nudge(body, dx, dy) {
+    if (!this.#usable()) return false;
+    const sv = this.sv, live = sv.live, st = sv.stageA;
+    const p = live.paramVector(sv.params);
+    const positive = (sv.spec.positive_coordinates || []).map((q) => live.meta.coordinates.indexOf(q)).filter((j) => j >= 0);
+    const again = this.keyed && this.keyed.changes === sv.changes;
+    let y = again ? live.state(sv.initial) : this.#drawnState(live.state(sv.initial));
+    for (let j = 0; j < live.n; j++) y[live.n + j] = 0;
+    const view = again ? this.keyed.view : st.view;
+    const seen = view.project(live.places(y, p)[body]);
+    const to = [seen[0] + dx, seen[1] + dy];
+    if (view.is3D) y = placeOnScreen(live, body, view, to, seen[2], y, p, { positive });
+    else y = live.reach(body, unproject(view, to[0], to[1], live.places(y, p)[body][2]), y, p);
+    for (let j = 0; j < live.n; j++) y[live.n + j] = 0;
+    const values = {};
+    const w = wrapped(live, y, p);
+    live.meta.coordinates.forEach((q, j) => { values[q] = w[j]; values[`${q}_dot`] = 0; });
+    sv.time = 0;
+    sv.setInitial(values);
+    this.keyed = { changes: sv.changes, view };
+    this.kept = { view, changes: sv.changes };
+    sv.schedule(400); // the server's run once the keys rest
+    return true;
+  }
+
   /** Where the velocity arrow's tip is on the screen: the start's place moved as far as the
    * pointer moved since the press (the body may have been taken while it swung elsewhere). */
   #tip(d, from) {

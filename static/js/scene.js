@@ -24,6 +24,8 @@ import { LiveModel, PREVIEW_LABEL, forDisplay } from "./live.js";
 import { BodyDrag } from "./livedrag.js";
 import { loadPlotly } from "./lazy.js";
 import { plotRun, plotlyReady } from "./plots.js";
+import { LectureStrip } from "./strip.js";
+import { SceneAccess } from "./access.js";
 import { showWork, watchWorkInputs } from "./work.js";
 
 const $ = (id) => document.getElementById(id);
@@ -104,9 +106,11 @@ class SceneView {
     this.#waiting("Computing the motion…");
     this.#syncPlay();
     this.#playback();
+    this.strip = new LectureStrip({ play: $("play") }); // lecture mode's controls by the step
     this.lecture = new Lecture({
       list: $("steps"), toggle: $("lecture-toggle"), counter: $("step-counter"),
-      onToggle: () => {
+      onToggle: (on) => {
+        this.strip.set(on);
         this.#saveURL(); this.#plot(); this.#label(this.shown);
         this.stageA.instruments?.relayout(); // the bars' labels at the lecture size, or back
         this.fbd(true); // and the diagram's
@@ -121,6 +125,7 @@ class SceneView {
     $("phase-q").addEventListener("change", () => { this.phase = $("phase-q").value; this.#saveURL(); this.#plot(); });
     $("reset").addEventListener("click", () => this.#reset());
     this.drag = new BodyDrag(this);
+    this.access = new SceneAccess(this); // keys on the canvas, the scene in words (access.js)
     this.#loop();
     for (const id of ["plot-q", "plot-phase", "plot-energy"]) {
       if ($(id) && !$(id).childElementCount) {
@@ -187,6 +192,7 @@ class SceneView {
       rows.push({ name: `${q}_dot`, value: this.initial[`${q}_dot`], unit: units[q] ? `${units[q]}/s` : "" });
     }
     buildControls($("initial"), rows, changed(this.initial), commit);
+    this.strip?.build();
   }
 
   /** New initial values from a drag on the canvas: controls, URL and the live preview follow. */
@@ -427,6 +433,7 @@ class SceneView {
     if (!on) this.#toSample();
     this.#syncPlay();
     if (!on) this.fbd(true);
+    if (!on) this.access?.describe(); // paused: the scene said in words, once
   }
 
   /** Paused (or scrubbed, or stepped): the clock goes to the nearest sample the server measured.
