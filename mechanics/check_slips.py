@@ -12,6 +12,7 @@ the student typed and the term it sits in. Nothing is claimed on samples alone.
 
 from __future__ import annotations
 
+import cmath
 import itertools
 from typing import Any
 
@@ -65,8 +66,11 @@ def sign_of_a_term(judge: Any, expected: sp.Expr) -> list[str]:
     terms = sp.Add.make_args(judge.given)
     if not 1 < len(terms) <= MAX_TRIES:
         return []
+    motion = judge.quantity in ("eom", "V", "L")
+    given = judge.values(judge.given, motion)  # each candidate's values: given − 2 · term
     for term in terms:
-        if _right(judge, judge.given - 2 * term, expected):
+        flipped = [g - 2 * x for g, x in zip(given, judge.values(term, motion), strict=True)]
+        if _right(judge, judge.given - 2 * term, expected, flipped):
             moved = judge._moved_term(term)
             return [
                 f"Sign error in your term {judge._show(term)}{moved}: it should be "
@@ -122,21 +126,47 @@ def _plain(judge: Any, expr: sp.Expr) -> str:
     return sp.sstr(expr.xreplace(names))
 
 
-def _right(judge: Any, candidate: sp.Expr, expected: sp.Expr) -> bool:
-    """Would the changed answer be right, as the quantity asks? Screened at the samples,
+def _right(
+    judge: Any, candidate: sp.Expr, expected: sp.Expr, values: list[complex] | None = None
+) -> bool:
+    """Would the changed answer be right, as the quantity asks? Screened at the samples (its
+    ``values`` there when the caller has them: the motion's states for an equation, V and L),
     then proved."""
     from mechanics.check import constant_proof, zero_proof
 
     quantity, m = judge.quantity, judge.m
+    motion = quantity in ("eom", "V", "L")
+    mine = values if values is not None else judge.values(candidate, motion)
+    theirs = _expected_values(judge, expected, motion)
     if quantity == "eom":
-        if judge._ratio(candidate, expected, motion_only=True) in (None, 0):
+        ratios = [x / y for x, y in zip(mine, theirs, strict=True) if abs(y) > 1e-12]
+        if len(ratios) < len(mine) // 2 or not _one_number(ratios, None) or ratios[0] == 0:
             return False
         return judge._multiple_proof(candidate, expected) is True
+    gaps = [x - y for x, y in zip(mine, theirs, strict=True)]
     if quantity in ("V", "L"):
-        return judge._constant(candidate - expected) and (
-            constant_proof(candidate - expected, m) is True
-        )
-    return judge.same(candidate, expected) and zero_proof(candidate - expected, m) is True
+        return _one_number(gaps, None) and constant_proof(candidate - expected, m) is True
+    return _one_number(gaps, 0) and zero_proof(candidate - expected, m) is True
+
+
+def _expected_values(judge: Any, expected: sp.Expr, motion: bool) -> list[complex]:
+    """The expected result at the samples, once per check."""
+    memo = judge.__dict__.setdefault("_slip_memo", {})
+    key = (expected, motion)
+    if key not in memo:
+        memo[key] = judge.values(expected, motion)
+    return memo[key]
+
+
+def _one_number(xs: list[complex], value: complex | None) -> bool:
+    """Are all of ``xs`` finite and one number (``value`` when given, else the first), to the
+    checker's tolerance?"""
+    from mechanics.check import TOLERANCE
+
+    if not xs or not all(cmath.isfinite(x) for x in xs):
+        return False
+    target = xs[0] if value is None else value
+    return all(abs(x - target) <= TOLERANCE * max(1.0, abs(target), abs(x)) for x in xs)
 
 
 def _sentence(judge: Any, factor: sp.Expr, flipped: sp.Expr, which: str, candidate: sp.Expr) -> str:
