@@ -21,6 +21,7 @@ import sympy as sp
 from mechanics.answers import read_answer
 from mechanics.expr import ExprError
 from mechanics.model import T as t
+from mechanics.steps import partial
 
 #: A bracket with more terms than this is not tried (2**k sign patterns).
 MAX_GROUP_TERMS = 4
@@ -53,7 +54,8 @@ def sign_in_group(judge: Any, expected: sp.Expr, fb: list[str]) -> bool:
                 continue
             if _right(judge, candidate, expected):
                 same = [b for b in _brackets(text) if text[b[0] : b[1]] == text[start:end]]
-                which = _ORDINALS[same.index((start, end))] if len(same) > 1 else ""
+                n = same.index((start, end))
+                which = "" if len(same) == 1 else _ORDINALS[n] if n < 8 else f"number {n + 1}"
                 fb.append(_sentence(judge, factor, flipped, which, candidate))
                 return True
     return False
@@ -132,7 +134,7 @@ def _right(
     """Would the changed answer be right, as the quantity asks? Screened at the samples (its
     ``values`` there when the caller has them: the motion's states for an equation, V and L),
     then proved."""
-    from mechanics.check import constant_proof, zero_proof
+    from mechanics.check import _never_zero, constant_proof, zero_proof
 
     quantity, m = judge.quantity, judge.m
     motion = quantity in ("eom", "V", "L")
@@ -142,7 +144,10 @@ def _right(
         ratios = [x / y for x, y in zip(mine, theirs, strict=True) if abs(y) > 1e-12]
         if len(ratios) < len(mine) // 2 or not _one_number(ratios, None) or ratios[0] == 0:
             return False
-        return judge._multiple_proof(candidate, expected) is True
+        if judge._multiple_proof(candidate, expected) is not True:
+            return False
+        qdd = m.qdd[judge.j]  # a multiple that vanishes at some parameters hides the equation
+        return _never_zero(partial(candidate, qdd, m) / partial(expected, qdd, m))
     gaps = [x - y for x, y in zip(mine, theirs, strict=True)]
     if quantity in ("V", "L"):
         return _one_number(gaps, None) and constant_proof(candidate - expected, m) is True
