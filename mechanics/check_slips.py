@@ -26,6 +26,8 @@ from mechanics.steps import partial
 #: A bracket with more terms than this is not tried (2**k sign patterns).
 MAX_GROUP_TERMS = 4
 _ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth", "seventh", "eighth")
+#: A bracket's text longer than this is not read as a sum of parameters.
+MAX_GROUP_TEXT = 60
 #: At most this many changed answers are judged per check (each is a parse and a proof).
 MAX_TRIES = 24
 
@@ -95,8 +97,10 @@ def _brackets(text: str) -> list[tuple[int, int]]:
 
 def _parameter_sum(judge: Any, inner: str) -> sp.Expr | None:
     """The bracket's content when it is a sum of 2 to MAX_GROUP_TERMS terms, at least two of
-    them holding a parameter, and no coordinate, rate or time; else None."""
-    if "=" in inner or not inner.strip():
+    them holding a parameter, and no coordinate, rate or time; else None. A bracket longer
+    than MAX_GROUP_TEXT characters is no such sum (and a hostile answer's hundreds of nested
+    brackets are not each parsed)."""
+    if "=" in inner or not inner.strip() or len(inner) > MAX_GROUP_TEXT:
         return None
     try:
         factor, _ = read_answer(judge.d, judge.quantity, inner, judge.j, exact_decimals=True)
