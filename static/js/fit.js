@@ -183,11 +183,12 @@ function breakAt(tex, lines, fine) {
   sides.forEach((s, j) => { if (s.length > sides[k].length) k = j; });
   if (k === 0) { // "long sum = 0": break the left side, keep "= 0" on the last line
     const parts = pieces(sides[0], fine);
-    if (parts.length < 2) return null;
+    if (parts.length < 2 && !left) return null;
     const rows = pack(parts, Math.min(lines, parts.length));
     const rest = sides.slice(1).join(" = ");
     const out = rows.map((r, j) => (j === 0 ? `&${r}` : `&\\quad ${r}`));
-    out[out.length - 1] += ` = ${rest}`;
+    if (left) out.push(`&\\quad = ${rest}`); // (flush: the other side on a row of its own)
+    else out[out.length - 1] += ` = ${rest}`;
     return `\\begin{aligned}${out.join(" \\\\ ")}\\end{aligned}`;
   }
   const lhs = sides.slice(0, k).join(" = ");
@@ -216,8 +217,8 @@ function breakAt(tex, lines, fine) {
     out.push(...alignedRows("\\text{den}", denParts, denRows));
   } else {
     const parts = pieces(rhs, fine);
-    if (parts.length < 2) return null;
-    out.push(...alignedRows(lhs, parts, lines));
+    if (parts.length < 2 && !left) return null;
+    out.push(...alignedRows(lhs, parts, lines)); // (flush: one side a row, the other the next)
   }
   if (after.length) out[out.length - 1] += ` = ${after.join(" = ")}`;
   return `\\begin{aligned}${out.join(" \\\\ ")}\\end{aligned}`;
