@@ -7,8 +7,11 @@ the server tells students apart for its per-client limits, and does what a stude
 think time between steps: open a scene's page and its assets (once; they are cached after),
 derive, simulate (with the equilibria the page asks for alongside), drag sliders (simulate again
 with other parameters), check answers (one right, one wrong), and now and then post an edited
-spec. A few hostile requests (huge powers in answers, a heavy posted spec, a built-in run that
-asks for minutes of work) arrive spread over the run, each from its own address.
+spec. Every student sends values of its own (issue 24): its own parameters and initial state from
+the first run on, and its own wording of each answer, so nothing it asks is in the server's caches
+because another student asked it first. A few hostile requests (huge powers in answers, a heavy
+posted spec, a built-in run that asks for minutes of work) arrive spread over the run, each from
+its own address; ``posters`` clients post heavy specs (each new) one after another all along.
 
 Everything is bounded: the crowd, the run's duration (students start nothing new after it), each
 request's timeout, and the wait for the crowd to finish; all traffic goes to 127.0.0.1.
@@ -37,8 +40,10 @@ import httpx
 HOST = "127.0.0.1"
 #: One request may take this long before it counts as an error.
 REQUEST_TIMEOUT = 30.0
-#: The endpoints the issue's targets are about (built-in scenes) and their p95 bound.
-TARGET_ENDPOINTS = ("page", "derive", "simulate", "check")
+#: The endpoints the issue's targets are about (built-in scenes) and their p95 bound (ms): a new
+#: answer to check may take a second (sympy judges it), the rest 300 ms.
+TARGETS_MS = {"page": 300.0, "derive": 300.0, "simulate": 300.0, "equilibria": 300.0, "check": 1e3}
+TARGET_ENDPOINTS = tuple(TARGETS_MS)
 TARGET_P95_MS = 300.0
 #: What the page asks for on every run (static/js/scene.js SERVER_FPS, integrator.js defaults):
 #: 30 samples a second, drawn at 60 by interpolation.
@@ -71,12 +76,21 @@ class Student:
     """One student: a client with its own source address, a tally, a random stream, a deadline."""
 
     def __init__(
-        self, base: str, address: str, tally: Tally, rng: random.Random, think: float, stop: float
+        self,
+        base: str,
+        address: str,
+        tally: Tally,
+        rng: random.Random,
+        think: float,
+        stop: float,
+        method: str | None = "dop853_c",
     ):
         transport = httpx.AsyncHTTPTransport(local_address=address)
         self.http = httpx.AsyncClient(base_url=base, transport=transport, timeout=REQUEST_TIMEOUT)
         self.tally, self.rng, self.think, self.stop = tally, rng, think, stop
         self.seen_assets: set[str] = set()
+        #: the method its runs name (None: the API's default, as a REST client sends them)
+        self.method = method
 
     async def call(self, label: str, method: str, url: str, body: dict | None = None) -> bytes:
         """One timed request; its body is read raw (not decompressed) unless ``label`` needs it.
@@ -133,31 +147,39 @@ class Student:
         derived = await self.call("derive", "POST", "/api/v1/derive", {"scene_id": scene_id})
         answers = _energies(json.loads(derived)) if derived else {}
         await self.pause()
-        params = dict(spec.get("parameters", {}))
-        await self.run(scene_id, params)
+        params = {k: _own(v, self.rng, 0.9, 1.1) for k, v in spec.get("parameters", {}).items()}
+        initial = {k: _own(v, self.rng, 0.95, 1.05) for k, v in spec.get("initial", {}).items()}
+        await self.run(scene_id, params, initial)
         for _ in range(self.rng.randint(1, 3)):  # a slider dragged and let go
             await self.pause(0.5)
             name = self.rng.choice(sorted(params)) if params else None
             if name is not None:
-                params[name] = round(params[name] * self.rng.uniform(0.8, 1.25), 3)
-            await self.run(scene_id, params)
+                params[name] = _own(params[name], self.rng, 0.8, 1.25)
+            await self.run(scene_id, params, initial)
         for quantity, right in answers.items():
             await self.pause()
-            await self.check(scene_id, quantity, right)
-            wrong = f"{self.rng.choice([2, 3, 0.5, -1])}*({right})"
+            n = self.rng.randint(2, 10**6)  # the right answer in the student's own words
+            await self.check(scene_id, quantity, f"({right})*{n}/{n}")
+            wrong = f"{self.rng.randint(2, 10**6)}/{self.rng.randint(2, 999)}*({right})"
             await self.pause()
             await self.check(scene_id, quantity, wrong)
         if spec and self.rng.random() < posted_share:
             await self.pause()
             edited = _edited(spec, self.rng)
             await self.call("derive (posted)", "POST", "/api/v1/derive", {"scene": edited})
-            body = {"scene": edited, **PAGE_RUN}
+            body = {"scene": edited, **self.run_options()}
             await self.call("simulate (posted)", "POST", "/api/v1/simulate", body)
         await self.pause()
 
-    async def run(self, scene_id: str, params: dict) -> None:
+    def run_options(self) -> dict:
+        """PAGE_RUN, with the student's method (none: the API's default)."""
+        options = {k: v for k, v in PAGE_RUN.items() if k != "method"}
+        return options | ({"method": self.method} if self.method else {})
+
+    async def run(self, scene_id: str, params: dict, initial: dict | None = None) -> None:
         """What the page sends on every run: a simulation and the equilibria, side by side."""
-        sim = {"scene_id": scene_id, "parameters": params, "constraint_forces": True, **PAGE_RUN}
+        sim = {"scene_id": scene_id, "parameters": params, "constraint_forces": True}
+        sim |= self.run_options() | ({"initial": initial} if initial else {})
         eq = {"scene_id": scene_id, "parameters": params}
         await asyncio.gather(
             self.call("simulate", "POST", "/api/v1/simulate", sim),
@@ -188,6 +210,12 @@ def _energies(derivation: dict) -> dict[str, str]:
             if label in ("T", "V") and plain.startswith(f"{label} = "):
                 out[label] = plain.removeprefix(f"{label} = ")
     return out
+
+
+def _own(value: float, rng: random.Random, low: float, high: float) -> float:
+    """A value of the student's own near ``value`` (the same sign; 0 stays 0, so a state at rest
+    or on a constraint's boundary stays there)."""
+    return round(float(value) * rng.uniform(low, high), 6)
 
 
 def _edited(spec: dict, rng: random.Random) -> dict:
@@ -247,18 +275,52 @@ async def probe_health(base: str, stop: float, tally: Tally) -> None:
             await asyncio.sleep(1.0)
 
 
-async def crowd(base: str, students: int, think: float, duration: float, hostile: int) -> Tally:
-    """Run the crowd against the server at ``base`` for ``duration`` seconds."""
+async def post_heavy_specs(base: str, index: int, stop: float, tally: Tally) -> None:
+    """One client that posts heavy specs (a six-link chain, each new) one after another until
+    ``stop``: derive, then simulate it. Its answers are tallied as "poster ..." (not honest)."""
+    from mechanics.bench import chain_spec
+
+    rng = random.Random(1000 + index)
+    transport = httpx.AsyncHTTPTransport(local_address=f"127.0.252.{index + 1}")
+    async with httpx.AsyncClient(base_url=base, transport=transport, timeout=45.0) as http:
+        while time.monotonic() < stop:
+            spec = chain_spec(6)
+            spec["parameters"]["g"] = round(9.0 + rng.random(), 9)
+            for label, path, body in (
+                ("poster derive", "/api/v1/derive", {"scene": spec}),
+                ("poster simulate", "/api/v1/simulate", {"scene": spec, "t_end": 10}),
+            ):
+                t0 = time.perf_counter()
+                try:
+                    status: int | str = (await http.post(path, json=body)).status_code
+                except httpx.HTTPError as exc:
+                    status = type(exc).__name__
+                tally.hostile.append((label, status, time.perf_counter() - t0))
+
+
+async def crowd(
+    base: str,
+    students: int,
+    think: float,
+    duration: float,
+    hostile: int,
+    method: str | None = "dop853_c",
+    posters: int = 0,
+) -> Tally:
+    """Run the crowd against the server at ``base`` for ``duration`` seconds; the students' runs
+    name ``method`` (None: the API's default), and ``posters`` clients post heavy specs."""
     tally = Tally()
     rng = random.Random(12)
     async with httpx.AsyncClient(base_url=base, timeout=REQUEST_TIMEOUT) as http:
         scenes = [s["id"] for s in (await http.get("/api/v1/scenes")).json()]
+    # before the clock starts: it imports the engine (seconds on a busy machine), blocking the loop
+    attacks = hostile_requests(hostile, rng)
     stop = time.monotonic() + duration
     ramp = min(10.0, duration / 4)
 
     async def student(i: int) -> None:
         address = f"127.0.{1 + i // 250}.{1 + i % 250}"
-        me = Student(base, address, tally, random.Random(i), think, stop)
+        me = Student(base, address, tally, random.Random(i), think, stop, method)
         async with me.http:
             await asyncio.sleep(me.rng.uniform(0, ramp))
             try:
@@ -267,12 +329,12 @@ async def crowd(base: str, students: int, think: float, duration: float, hostile
             except TimeUp:
                 pass
 
-    attacks = hostile_requests(hostile, rng)
     tasks = [student(i) for i in range(students)]
     tasks += [
         send_hostile(base, j, ramp + (duration - ramp) * (j + 0.5) / max(1, hostile), a, tally)
         for j, a in enumerate(attacks)
     ]
+    tasks += [post_heavy_specs(base, j, stop, tally) for j in range(posters)]
     tasks.append(probe_health(base, stop, tally))
     # past the end, a student finishes the request it is in (a hostile one up to 45 s)
     await asyncio.wait_for(asyncio.gather(*tasks), duration + 2 * think + 2 * REQUEST_TIMEOUT)
@@ -392,7 +454,16 @@ async def watch_rss(root: int, stop: float, samples: list[float]) -> None:
 # --- one configuration, and the report ----------------------------------------------------------
 
 
-def run_config(workers: int, students: int, think: float, duration: float, hostile: int) -> dict:
+def run_config(
+    workers: int,
+    students: int,
+    think: float,
+    duration: float,
+    hostile: int,
+    method: str | None = "dop853_c",
+    posters: int = 0,
+) -> dict:
+    """One configuration against a fresh server (its own empty cache); the result's numbers."""
     port = free_port()
     log = Path(os.environ.get("TMPDIR", "/tmp")) / f"lagrange-lab-load-{port}.log"
     cache = tempfile.TemporaryDirectory(prefix="lagrange-lab-load-")  # every run starts alike
@@ -406,12 +477,15 @@ def run_config(workers: int, students: int, think: float, duration: float, hosti
             bound = time.monotonic() + duration + 2 * think + 2 * REQUEST_TIMEOUT
             watcher = asyncio.create_task(watch_rss(server.pid, bound, rss))
             try:
-                return await crowd(base, students, think, duration, hostile), rss
+                tally = await crowd(base, students, think, duration, hostile, method, posters)
+                return tally, rss
             finally:
                 watcher.cancel()
 
         cpu, server_cpu = time.process_time(), tree_cpu_seconds(server.pid)
+        load_before = os.getloadavg()[0]
         tally, rss = asyncio.run(measured())
+        load_after = os.getloadavg()[0]
         cpu, server_cpu = time.process_time() - cpu, tree_cpu_seconds(server.pid) - server_cpu
         end_rss, processes = tree_rss_mib(server.pid)
     finally:
@@ -423,6 +497,10 @@ def run_config(workers: int, students: int, think: float, duration: float, hosti
         "think": think,
         "duration": duration,
         "hostile": hostile,
+        "method": method or "default",
+        "posters": posters,
+        #: the machine's 1-minute load average as the crowd started and ended (it is shared)
+        "load": (load_before, load_after),
         "tally": tally,
         "rss_peak": max(rss, default=end_rss),
         "rss_end": end_rss,
@@ -444,7 +522,9 @@ def print_config(result: dict) -> dict[str, float]:
     print(
         f"\n## {result['workers']} worker{'s' if result['workers'] > 1 else ''}, "
         f"{result['students']} students, think {result['think']:g} s, {result['duration']:g} s, "
-        f"{result['hostile']} hostile"
+        f"{result['hostile']} hostile, {result.get('posters', 0)} heavy-spec posters, method "
+        f"{result.get('method', 'dop853_c')}; load average "
+        + " → ".join(f"{x:.1f}" for x in result.get("load", ()))
     )
     head = (
         f"{'endpoint':<20} {'n':>6} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} "
@@ -485,11 +565,12 @@ def print_config(result: dict) -> dict[str, float]:
             )
     for kind, status, seconds in sorted(t.hostile, key=lambda h: h[0]):
         print(f"hostile {kind:<28} -> {status} in {seconds:5.1f} s")
-    worst = max((p95.get(e, float("inf")) for e in TARGET_ENDPOINTS), default=float("inf"))
-    met = worst <= TARGET_P95_MS and errors == 0 and server_errors == 0
+    missed = [e for e, ms in TARGETS_MS.items() if not p95.get(e, float("inf")) <= ms]
+    met = not missed and errors == 0 and server_errors == 0
+    targets = ", ".join(f"{e} {ms:g}" for e, ms in TARGETS_MS.items())
     print(
-        f"target p95 ≤ {TARGET_P95_MS:g} ms for {', '.join(TARGET_ENDPOINTS)} (worst "
-        f"{worst:.0f} ms), 0 errors, 0 5xx: {'met' if met else 'not met'}"
+        f"target p95 (ms) {targets}, 0 errors, 0 5xx: {'met' if met else 'not met'}"
+        + (f" (missed: {', '.join(missed)})" if missed else "")
     )
     return p95
 
