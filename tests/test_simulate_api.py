@@ -132,3 +132,44 @@ def test_a_posted_scene_runs_compiled_in_the_budgeted_child_like_a_builtin():
     assert a["warnings"] == [] and a["stats"]["method"] == "dop853_c"
     assert a["stats"]["steps"] == b["stats"]["steps"]
     assert a["q"]["theta2"][-1] == pytest.approx(b["q"]["theta2"][-1], rel=1e-9)
+
+
+# --- the default method (issue 24, item 1) -----------------------------------------------------
+
+
+def test_the_default_method_is_dop853_in_c_and_takes_scipys_dop853_steps():
+    """No method named: DOP853's steps taken in C. The oracle is scipy's DOP853 itself (the
+    same tableau and step control): the same accepted steps and samples equal to rounding."""
+    asked = {"scene_id": "double_pendulum", "t_end": 4, "rtol": 1e-10, "atol": 1e-10}
+    default, scipy = post(**asked).json(), post(**asked, method="DOP853").json()
+    assert default["stats"]["method"] == "dop853_c"
+    assert default["stats"]["method_requested"] == "dop853_c"
+    assert scipy["stats"]["method"] == scipy["stats"]["method_requested"] == "DOP853"
+    assert default["stats"]["steps"] == scipy["stats"]["steps"]
+    for name in ("theta1", "theta2"):
+        assert default["q"][name] == pytest.approx(scipy["q"][name], rel=1e-9, abs=1e-11)
+    assert not any("scipy's DOP853" in w for w in default["warnings"])
+
+
+def test_without_a_c_compiler_the_default_runs_scipys_dop853_and_says_so(monkeypatch):
+    from mechanics import native
+
+    monkeypatch.setenv(native.ENV_VAR, "none")
+    native._kernel.cache_clear()
+    try:
+        # a t_end of its own: a built-in run is remembered by its request (app/memo.py)
+        body = post(scene_id="simple_pendulum", t_end=3.25).json()
+    finally:
+        native._kernel.cache_clear()
+    assert body["stats"]["method"] == "DOP853"  # what ran, not what was asked
+    assert body["stats"]["method_requested"] == "dop853_c"
+    assert any("scipy's DOP853" in w and "C compiler" in w for w in body["warnings"])
+
+
+def test_a_scene_whose_stop_chatters_is_stepped_by_scipy_and_its_stats_say_so():
+    """incline_friction's stop (the block sticking) is crossed either way: stepped in Python,
+    watched every step; the stats name DOP853, the method that ran."""
+    body = post(scene_id="incline_friction", t_end=2.5).json()
+    assert body["stats"]["method"] == "DOP853"
+    assert body["stats"]["method_requested"] == "dop853_c"
+    assert any("reversal is caught every step" in w for w in body["warnings"])
