@@ -5,9 +5,12 @@ simplified), its warm answer over HTTP, and sympy's LagrangesMethod followed by 
 mass matrix and forcing on the same system — the baseline a careful student would write. Ratios
 rather than absolute times, because the machine's speed drifts.
 
-Then three systems larger than any built-in scene (a triple pendulum, a heavy symmetric top through
-three Euler rotations, a six-link chain), each derived cold: a fresh process with an empty cache,
-the way a posted scene is first derived. Wall and CPU seconds, median of a few runs.
+Then systems larger than any built-in scene (a triple pendulum, a heavy symmetric top through
+three Euler rotations, a six-link chain, and mechanics/systems_large.py's restricted three-body
+problem and conical pendulums of two and three links), each derived cold: a fresh process with an
+empty cache, the way a posted scene is first derived. Wall and CPU seconds, median of a few runs,
+and the 1-minute load average when each system started (the machine is shared: CPU seconds are
+the steadier number under load).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ from sympy.core.cache import clear_cache
 from mechanics import oracle
 from mechanics.derive import derivation_of_scene
 from mechanics.scenes import scene_ids
+from mechanics.systems_large import LARGE_SYSTEMS
 
 
 def chain_spec(n: int) -> dict:
@@ -80,6 +84,7 @@ SYSTEMS = {
     "triple_pendulum": chain_spec(3),
     "heavy_top": HEAVY_TOP,
     "six_link_chain": chain_spec(6),
+    **LARGE_SYSTEMS,  # issue 23, item 8: the three-body problem, conical pendulums
 }
 
 #: One cold derivation in a fresh process: prints import and derive seconds (wall, CPU) as JSON.
@@ -100,6 +105,7 @@ def bench_systems(names: list[str], runs: int = 3) -> list[dict]:
     rows = []
     for name in names:
         samples = []
+        load = os.getloadavg()[0]
         for _ in range(runs):
             with tempfile.TemporaryDirectory(prefix="lagrange-lab-bench-") as empty:
                 env = os.environ | {"LAGRANGE_LAB_CACHE": empty}
@@ -111,7 +117,7 @@ def bench_systems(names: list[str], runs: int = 3) -> list[dict]:
                     check=True,
                 )
             samples.append(json.loads(done.stdout))
-        row = {"system": name, "solved": samples[0]["solved"]}
+        row = {"system": name, "solved": samples[0]["solved"], "load": load}
         for key in ("import_s", "derive_s", "derive_cpu_s", "total_s"):
             row[key] = statistics.median(s[key] for s in samples)
         rows.append(row)
@@ -121,14 +127,15 @@ def bench_systems(names: list[str], runs: int = 3) -> list[dict]:
 def print_systems(rows: list[dict]) -> None:
     head = (
         f"{'system (cold, fresh process)':<30} {'import s':>8} {'derive s':>8} {'CPU s':>6} "
-        f"{'total s':>7}  q̈ solved"
+        f"{'total s':>7} {'load':>5}  q̈ solved"
     )
     print(head)
     print("-" * len(head))
     for r in rows:
         print(
             f"{r['system']:<30} {r['import_s']:8.2f} {r['derive_s']:8.2f} "
-            f"{r['derive_cpu_s']:6.2f} {r['total_s']:7.2f}  {'yes' if r['solved'] else 'no'}"
+            f"{r['derive_cpu_s']:6.2f} {r['total_s']:7.2f} {r['load']:5.2f}  "
+            f"{'yes' if r['solved'] else 'no'}"
         )
 
 
@@ -250,6 +257,7 @@ def main(argv: list[str] | None = None) -> int:
     d.add_argument(
         "scenes", nargs="*", help=f"scene ids and/or {', '.join(SYSTEMS)} (default: all)"
     )
+    d.add_argument("--runs", type=int, default=3, help="cold runs per larger system (median)")
     i = sub.add_parser("integrate", help="work-precision table of the integrators vs a baseline")
     i.add_argument("scenes", nargs="*", help="scene ids of the problems to run (default: all)")
     i.add_argument("--html", default="work-precision.html", help="where to write the diagram")
@@ -283,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
             print_derive(bench_derive(scenes))
         if systems:
             print("\n" if scenes else "", end="")
-            print_systems(bench_systems(systems))
+            print_systems(bench_systems(systems, max(1, min(args.runs, 9))))
     else:
         from mechanics.bench_integrate import main as integrate_main
 

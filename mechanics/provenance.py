@@ -53,6 +53,11 @@ MAX_ORIGINS = 400
 #: four-link chain 280 (2.5 s), a six-link chain about 1500 (8 s, on top of a 13 s derivation
 #: whose posted budget is 20 s).
 MAX_CONTRIBUTIONS = 600
+#: ... and while the same count weighted by each share's size (count_ops) stays within this: the
+#: shares of a 3-D system are larger, and a two-link conical pendulum (560 contributions, but
+#: 9,856 weighted) took 10 s to trace on top of a 10 s derivation. A triple pendulum weighs 1,212,
+#: a heavy top 1,125, a four-link chain 3,040, the built-in scenes at most 352.
+MAX_OPS = 3200
 #: A contribution larger than this (count_ops) is shown expanded, not tidied: tidying every
 #: contribution was two thirds of the time on a six-link chain, and small ones are most of them.
 TIDY_OPS = 40
@@ -396,6 +401,12 @@ def force_origins(model: Any, j: int) -> list[Origin]:
     return out
 
 
+def _contribution_ops(t_parts: list, v_parts: list, n: int) -> int:
+    """The size-weighted count of contributions to differentiate and split (see MAX_OPS)."""
+    t_ops = sum(sp.count_ops(e) for _, _, e in t_parts)
+    return int(2 * n * t_ops + n * sum(sp.count_ops(e) for _, _, e in v_parts))
+
+
 # --- splitting an equation into terms ----------------------------------------------------------
 
 
@@ -539,6 +550,7 @@ def provenance(derivation: Any) -> dict[str, Any]:
     # Every share of T is differentiated twice per coordinate and V's once: past the budget the
     # equations of motion are not traced (T, V and Q_j still are).
     eom_too_large = (2 * len(t_parts) + len(v_parts)) * len(names) > MAX_CONTRIBUTIONS
+    eom_too_large = eom_too_large or _contribution_ops(t_parts, v_parts, len(names)) > MAX_OPS
     for j, name in enumerate(names):
         forces = force_origins(model, j)
         for i, o in enumerate(forces):
