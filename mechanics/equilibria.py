@@ -40,6 +40,7 @@ import sympy as sp
 from sympy.physics.vector import Vector
 
 from mechanics import equilibrium_branches as branches
+from mechanics import equilibrium_closed_form as closed_form
 from mechanics import equilibrium_families as families_
 from mechanics import equilibrium_flat as flat
 from mechanics import equilibrium_stability as stability
@@ -1118,6 +1119,12 @@ def _not_asked(eqs: tuple, n: int) -> str:
         return (
             "sympy is not asked to solve two trigonometric conditions at once (it can take minutes)"
         )
+    if any(closed_form.mixes_trig(e, _TRIG) for e in eqs):
+        return (
+            "A coordinate enters a condition both inside and outside a trigonometric function "
+            "(k θ = m g l sin θ), which has no closed form in general: sympy is not asked (it "
+            "can take a minute to say so)"
+        )
     return ""
 
 
@@ -1719,7 +1726,9 @@ def _linearization(mass: tuple, forcing: tuple, qs: tuple, qds: tuple, qdds: tup
     """M, K = −∂f/∂q and C = −∂f/∂q̇ at rest as one numpy function of (q, parameters), derived
     once per scene; None where the forces are not smooth at rest, for sympy to judge."""
     rest = {**dict.fromkeys(qdds, 0), **dict.fromkeys(qds, 0)}
-    K = [-_derivative(fj, q).xreplace(rest) for fj in forcing for q in qs]
+    # at rest first (it commutes with ∂/∂q): a damper's terms vanish before they are
+    # differentiated, 6.6 s of a damped pair's 11 s
+    K = [-_derivative(sp.S.Zero + fj.xreplace(rest), q) for fj in forcing for q in qs]
     C = [-_derivative(fj, qd).xreplace(rest) for fj in forcing for qd in qds]
     M = [sp.S.Zero + e.xreplace(rest) for e in mass]
     if any(e.has(*_NOT_ELEMENTARY) for e in (*M, *K, *C)):
@@ -1964,6 +1973,8 @@ def _stability(
     shown, latex_names = _eigen_math(lam), [to_latex(m.q[j]) for j in idx]
     single, potential = len(keep) == 1, _potential(_turning(m))
     kind, reason = flat.amend(kind, reason, report, latex_names, shown, single, potential)
+    if report and report.level:  # the zero modes are a family's, not (only) free coordinates'
+        reason = reason.replace("free direction(s)", "free or family direction(s)")
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
@@ -2365,6 +2376,8 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
     lam, vecs = lam[order], vecs[:, order]
     scale = max(1.0, float(np.max(np.abs(lam))))
     tol = stability.growth_tolerance(A, lam, np.linalg.solve(M, K))
+    if tol > 1e-7 * scale:  # K singular: the zero modes' round-off (±4·10⁻⁸) reads 0
+        lam = np.where(np.abs(lam) <= tol, 0.0, lam)
     k_shown = np.linalg.eigvalsh((K + K.T) / 2)  # what the sentences quote: K as displayed
     # The tests below judge K and C per unit of inertia (L⁻¹ K L⁻ᵀ with M = L Lᵀ: eigenvalues
     # ω² in 1/s²), so that no choice of mass or length unit moves them across a tolerance: with

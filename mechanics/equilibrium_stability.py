@@ -54,7 +54,7 @@ def conservative_eigenvalues(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, 
     for i in range(n):
         root = np.sqrt(complex(-w2[i]))
         for k, z in enumerate((root, -root)):
-            lam[2 * i + k] = z
+            lam[2 * i + k] = complex(z.real + 0.0, z.imag + 0.0)  # no −0.0 in the JSON
             col = np.concatenate([v[:, i], z * v[:, i]])
             vecs[:, 2 * i + k] = col / max(np.linalg.norm(col), 1e-300)
     return lam, vecs
