@@ -252,3 +252,14 @@ def test_a_kinetic_energy_with_v_in_it_is_named_so(scene, answer, written, sourc
 def test_a_kinetic_energy_with_another_extra_term_is_not_called_t_with_v():
     fb = lines("simple_pendulum", "T", "1/2 m l^2 theta'^2 + m g l sin(theta)")
     assert not any(line.startswith("Your T is") for line in fb), fb
+
+
+def test_a_kinetic_term_left_out_whole_is_not_a_second_order_approximation():
+    """Spherical pendulum, by hand: T = ½ m l² (θ̇² + sin²θ φ̇²), V = −m g l cos θ. Without the
+    φ̇² term (of fourth order at θ = 0, so the second-order Taylor polynomial loses it) the
+    answer has left the azimuthal motion out; with sin θ ≈ θ it keeps it, approximated."""
+    dropped = lines("spherical_pendulum", "L", "m l^2/2 theta'^2 - m g l theta^2/2")
+    assert not any("small-angle" in line for line in dropped), dropped
+    assert dropped[0].startswith("Missing term") and r"\dot{\phi}" in dropped[0], dropped
+    kept = lines("spherical_pendulum", "L", "m l^2/2 (theta'^2 + theta^2 phi'^2) - m g l theta^2/2")
+    assert len(kept) == 1 and "small-angle approximation" in kept[0], kept
