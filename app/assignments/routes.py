@@ -25,11 +25,12 @@ from mechanics.assignments.template import parse_template, parse_template_text, 
 
 from . import service
 from .db import DatabaseUnavailable
+from .pages import router as pages_router
 from .service import Refused
 from .store import Store
 from .tokens import digest
 
-router = APIRouter(prefix="/api/v1/assignments", tags=["assignments"])
+api = APIRouter(prefix="/api/v1/assignments", tags=["assignments"])
 
 ERRORS = {
     401: {"description": "No token, or one this server does not know (field `authorization`)."},
@@ -186,14 +187,14 @@ class StudentTokenBody(BaseModel):
 
 
 # -- instructor routes ---------------------------------------------------------------------------
-@router.get("/outcome-codes", summary="The outcome-code table")
+@api.get("/outcome-codes", summary="The outcome-code table")
 def get_codes() -> dict[str, Any]:
     """Every outcome kind (a code is `<T|V|L|Q|eom|accel|p>.<kind>`), what it means, and whether
     it scores the part in full. Public: it holds no key."""
     return {"prefixes": sorted(set(outcomes.PREFIX.values())), "kinds": outcomes.table()}
 
 
-@router.get("/templates", responses=ERRORS, summary="Templates (shipped and stored)")
+@api.get("/templates", responses=ERRORS, summary="Templates (shipped and stored)")
 @guarded
 def get_templates(who: Annotated[Caller, Depends(instructor)]) -> dict[str, Any]:
     from mechanics.assignments.template import shipped_templates
@@ -216,7 +217,7 @@ def get_templates(who: Annotated[Caller, Depends(instructor)]) -> dict[str, Any]
     return {"templates": sorted(out, key=lambda t: t["id"])}
 
 
-@router.post("/templates", status_code=201, responses=ERRORS, summary="Store a template")
+@api.post("/templates", status_code=201, responses=ERRORS, summary="Store a template")
 @guarded
 def post_template(body: TemplateBody, who: Annotated[Caller, Depends(instructor)]) -> dict:
     """Validated (its scene, its parts' coordinates) and stored under its id; posting the same
@@ -233,7 +234,7 @@ def post_template(body: TemplateBody, who: Annotated[Caller, Depends(instructor)
     return {"id": template.id, "sha256": sha}
 
 
-@router.get("/templates/{template_id}", responses=ERRORS, summary="One template")
+@api.get("/templates/{template_id}", responses=ERRORS, summary="One template")
 @guarded
 def get_template(template_id: str, who: Annotated[Caller, Depends(instructor)]) -> dict:
     template = service.find_template(store(), template_id)
@@ -243,7 +244,7 @@ def get_template(template_id: str, who: Annotated[Caller, Depends(instructor)]) 
     }
 
 
-@router.post(
+@api.post(
     "/templates/{template_id}/deploy",
     status_code=201,
     responses=ERRORS,
@@ -270,13 +271,13 @@ def post_deploy(
     return work()
 
 
-@router.get("/{assignment_id}/preview", responses=ERRORS, summary="Variants with their keys")
+@api.get("/{assignment_id}/preview", responses=ERRORS, summary="Variants with their keys")
 @guarded
 def get_preview(assignment_id: str, who: Annotated[Caller, Depends(instructor)]) -> dict:
     return service.preview(store(), assignment_id)
 
 
-@router.post("/{assignment_id}/close", responses=ERRORS, summary="Close (or reopen) it")
+@api.post("/{assignment_id}/close", responses=ERRORS, summary="Close (or reopen) it")
 @guarded
 def post_close(
     assignment_id: str, who: Annotated[Caller, Depends(instructor)], closed: bool = True
@@ -286,7 +287,7 @@ def post_close(
     return {"assignment_id": assignment_id, "closed": closed}
 
 
-@router.post("/students/tokens", status_code=201, responses=ERRORS, summary="Issue student tokens")
+@api.post("/students/tokens", status_code=201, responses=ERRORS, summary="Issue student tokens")
 @guarded
 def post_student_tokens(
     body: StudentTokenBody, who: Annotated[Caller, Depends(instructor)]
@@ -297,7 +298,7 @@ def post_student_tokens(
     return {"tokens": {s: create(store(), "student", s) for s in dict.fromkeys(body.students)}}
 
 
-@router.get("/{assignment_id}/scores", responses=ERRORS, summary="Every student's scores")
+@api.get("/{assignment_id}/scores", responses=ERRORS, summary="Every student's scores")
 @guarded
 def get_scores(
     assignment_id: str, http: Request, who: Annotated[Caller, Depends(instructor)]
@@ -306,7 +307,7 @@ def get_scores(
     return service.scores(store(), assignment_id)
 
 
-@router.get("/{assignment_id}/report", responses=ERRORS, summary="The class report (JSON/CSV)")
+@api.get("/{assignment_id}/report", responses=ERRORS, summary="The class report (JSON/CSV)")
 @guarded
 def get_report(
     assignment_id: str,
@@ -326,14 +327,14 @@ def get_report(
 
 
 # -- student routes ----------------------------------------------------------------------------
-@router.get("/{assignment_id}/mine", responses=ERRORS, summary="My variant (no key)")
+@api.get("/{assignment_id}/mine", responses=ERRORS, summary="My variant (no key)")
 @guarded
 def get_mine(assignment_id: str, who: Annotated[Caller, Depends(student)]) -> dict:
     """The caller's own variant: its scene, the parts, attempts left and scores. Never a key."""
     return service.student_view(store(), assignment_id, who.subject)
 
 
-@router.post(
+@api.post(
     "/{assignment_id}/parts/{part_id}/submit",
     responses={
         **ERRORS,
@@ -361,3 +362,9 @@ async def post_submit(
         )
 
     return await run_in_threadpool(work)
+
+
+#: What app/main.py includes: the REST routes and the two pages (app/assignments/pages.py).
+router = APIRouter()
+router.include_router(api)
+router.include_router(pages_router)
