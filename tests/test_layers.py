@@ -69,6 +69,7 @@ STAGE = {
     "warm": "serving",
     "serving": "serving",
     "api": "api",
+    "assignments": "api",
     "bench": "tools",
     "bench_integrate": "tools",
     "bench_load": "tools",

@@ -19,9 +19,10 @@ from typing import Any
 
 import sympy as sp
 
-from mechanics import oracle
 from mechanics.derive import Derivation
 from mechanics.model import T as t
+
+from . import second_route
 
 #: Past this many operations sympy's general simplify() is not tried (it can take minutes).
 SIMPLIFY_OPS = 600
@@ -54,7 +55,7 @@ class _Oracle:
         return sp.Add(*(b.sympy_body.kinetic_energy(self.m.N) for b in self.m.bodies))
 
     def V(self) -> sp.Expr:
-        return oracle.potential(self.m)
+        return second_route.potential(self.m)
 
     def L(self) -> sp.Expr:
         return self.T() - self.V()
@@ -63,7 +64,7 @@ class _Oracle:
         """Σ F·∂v_P/∂q̇_j + Σ τ·∂ω/∂q̇_j over the declared loads (dampers and forces)."""
         N, qd = self.m.N, self.m.qd[j]
         total = sp.S.Zero
-        for where, vector in oracle.loads(self.m):
+        for where, vector in second_route.loads(self.m):
             if isinstance(where, sp.physics.vector.ReferenceFrame):
                 rate = where.ang_vel_in(N)
             else:
@@ -73,7 +74,7 @@ class _Oracle:
 
     def lagranges(self) -> Any:
         if self._lm is None:
-            self._lm = oracle.lagranges_method(self.m)
+            self._lm = second_route.lagranges_method(self.m)
         return self._lm
 
     def eom(self, j: int) -> sp.Expr:
