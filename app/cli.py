@@ -12,7 +12,7 @@ from functools import partial
 
 import uvicorn
 
-from app.assignments.cli import add_token_command, run_token
+from app.assignments.cli import add_export_command, add_token_command, run_export, run_token
 from app.server import HEADER_TIMEOUT, HeaderDeadlineProtocol, install_connection_guard
 
 
@@ -23,6 +23,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     add_token_command(commands)  # lagrange-lab token create (app/assignments/cli.py)
+    add_export_command(commands)  # lagrange-lab export prairielearn TEMPLATE DIR
     serve = commands.add_parser("serve", help="start the web app (http://127.0.0.1:8000)")
     serve.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     serve.add_argument("--port", type=int, default=8000, help="port to bind (default 8000)")
@@ -68,6 +69,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command == "token":
         return run_token(args)
+    if args.command == "export":
+        return run_export(args)
     if args.command != "serve":
         parser.print_help()
         return 2
