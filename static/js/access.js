@@ -136,7 +136,7 @@ export class SceneAccess {
     });
     const coords = (this.sv.spec?.coordinates || []).map((q) => {
       const v = shown.q?.[q]?.[i];
-      return Number.isFinite(v) ? `${nameText(q)} = ${fmt(v, 3)}` : null;
+      return Number.isFinite(v) ? `${nameText(q)} = ${fmt(v, 4)}` : null;
     }).filter(Boolean);
     const e = shown.energy || {};
     const energy = ["T", "V", "E"].filter((k) => Number.isFinite(e[k]?.[i])).map((k) => `${k} = ${fmt(e[k][i], 3)} J`);

@@ -28,13 +28,17 @@ def tab_to(p, test: str, *, back: bool = False, limit: int = 250) -> None:
         if p.evaluate(f"(() => {{ const a = document.activeElement; return Boolean({test}); }})()"):
             return
         p.keyboard.press("Shift+Tab" if back else "Tab")
-    raise AssertionError(f"{test} not reached by {'Shift+' if back else ''}Tab; at {p.evaluate(ACTIVE)}")
+    raise AssertionError(
+        f"{test} not reached by {'Shift+' if back else ''}Tab; at {p.evaluate(ACTIVE)}"
+    )
 
 
 def wait_scene(p) -> None:
     p.wait_for_function("document.querySelector('#canvas').dataset.lastQ", timeout=90_000)
     p.wait_for_function("document.getElementById('steps').dataset.typeset === '1'", timeout=90_000)
-    p.wait_for_function("() => (document.documentElement.dataset.pending || '0') === '0'", timeout=60_000)
+    p.wait_for_function(
+        "() => (document.documentElement.dataset.pending || '0') === '0'", timeout=60_000
+    )
 
 
 def test_a_keyboard_alone_walks_the_catalog_a_scene_and_the_editor(server, page, artifacts):
@@ -75,7 +79,9 @@ def test_a_keyboard_alone_walks_the_catalog_a_scene_and_the_editor(server, page,
     p.wait_for_function(f"document.getElementById('n-theta').value !== {theta!r}")
     assert p.get_attribute("#play", "aria-pressed") == "false"  # held where the keys put it
     assert p.evaluate("scrollY") < 400  # the arrows moved the body, not the page
-    p.wait_for_function(f"document.querySelector('#canvas').dataset.run !== {runs!r}", timeout=60_000)
+    p.wait_for_function(
+        f"document.querySelector('#canvas').dataset.run !== {runs!r}", timeout=60_000
+    )
     p.wait_for_function("document.getElementById('scene-description').textContent.includes('bob')")
     p.screenshot(path=str(artifacts / "keyboard_canvas_focus.png"))
 
@@ -131,9 +137,11 @@ def test_a_keyboard_alone_walks_the_catalog_a_scene_and_the_editor(server, page,
 SMALL_TARGETS = """() => [...document.querySelectorAll(
     'a[href], button, input, select, textarea, summary, canvas[tabindex]')]
   .filter((e) => e.offsetParent !== null && !e.closest('.modebar') && e.type !== 'hidden')
-  .filter((e) => !(e.tagName === 'A' && e.closest('p, li, td, figcaption, caption') && !e.closest('.cards')))
+  .filter((e) => !(e.tagName === 'A' && e.closest('p, li, td, figcaption, caption')
+                   && !e.closest('.cards')))
   .map((e) => { const r = e.getBoundingClientRect();
-    return [e.tagName + '#' + e.id + '.' + e.className, Math.round(r.width), Math.round(r.height)]; })
+    return [e.tagName + '#' + e.id + '.' + e.className,
+            Math.round(r.width), Math.round(r.height)]; })
   .filter(([, w, h]) => w > 0 && (w < 24 || h < 24))"""
 
 
@@ -157,7 +165,8 @@ def test_typeset_math_keeps_its_speech(server, page):
     wait_scene(p)
     silent = p.evaluate(
         """[...document.querySelectorAll('#steps mjx-container')]
-           .filter((m) => !m.querySelector('mjx-assistive-mml math') && !m.getAttribute('aria-label'))
+           .filter((m) => !m.querySelector('mjx-assistive-mml math')
+                          && !m.getAttribute('aria-label'))
            .map((m) => m.dataset.tex || m.outerHTML.slice(0, 80))"""
     )
     assert p.evaluate("document.querySelectorAll('#steps mjx-container').length") > 50

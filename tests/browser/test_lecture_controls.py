@@ -77,12 +77,16 @@ def test_the_strip_is_beside_a_step_far_down_and_drives_the_run(server, browser,
         p.press("#strip-n-l2", "Enter")
         p.wait_for_function("document.getElementById('n-l2').value === '1.5'")
         p.wait_for_function("new URLSearchParams(location.search).get('l2') === '1.5'")
-        p.wait_for_function(f"document.querySelector('#canvas').dataset.run !== '{runs}'", timeout=60_000)
+        p.wait_for_function(
+            f"document.querySelector('#canvas').dataset.run !== '{runs}'", timeout=60_000
+        )
         # its play button is the page's: pauses and plays
         before = p.get_attribute("#play", "aria-pressed")
         p.click("#strip-play")
         assert p.get_attribute("#play", "aria-pressed") != before
-        assert p.get_attribute("#strip-play", "aria-pressed") == p.get_attribute("#play", "aria-pressed")
+        assert p.get_attribute("#strip-play", "aria-pressed") == p.get_attribute(
+            "#play", "aria-pressed"
+        )
         # the panel's value set from elsewhere (Reset) is shown in the strip too
         p.evaluate("document.getElementById('reset').click()")
         p.wait_for_function("document.getElementById('strip-n-l2').value === '1'")
