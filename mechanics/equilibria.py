@@ -1119,6 +1119,11 @@ def _not_asked(eqs: tuple, n: int) -> str:
         return (
             "sympy is not asked to solve two trigonometric conditions at once (it can take minutes)"
         )
+    if n == 2 and not all(closed_form.rational_in_coordinates(e) for e in eqs):
+        return (
+            "sympy is not asked to solve two conditions at once with radicals or other "
+            "non-rational functions of the coordinates in them (it can take minutes)"
+        )
     if any(closed_form.mixes_trig(e, _TRIG) for e in eqs):
         return (
             "A coordinate enters a condition both inside and outside a trigonometric function "

@@ -30,3 +30,16 @@ def mixes_trig(expr: Any, trig: tuple) -> bool:
         if outside & inside:
             return True
     return False
+
+
+def rational_in_coordinates(expr: Any) -> bool:
+    """Is ``expr`` a rational function of the coordinates (the applied functions q(t) in it),
+    whatever the parameters do? Two conditions with a radical of the coordinates (the
+    restricted three-body problem's 1/√((x + μ)² + y²)) kept sympy's solver 10 s to minutes
+    before it said it could not; polynomial and rational ones it settles or refuses quickly."""
+    coordinates = sorted(expr.atoms(AppliedUndef), key=str)
+    if not coordinates:
+        return True
+    symbols = [Dummy() for _ in coordinates]
+    plain = expr.xreplace(dict(zip(coordinates, symbols, strict=True)))
+    return bool(plain.is_rational_function(*symbols))
