@@ -18,11 +18,12 @@ from collections import Counter, OrderedDict, defaultdict
 from collections.abc import Callable
 from typing import Any
 
-from mechanics.assignments import grading
+from mechanics.assignments import grading, outcomes
 from mechanics.assignments.grading import AttemptsExhausted, Policy
 from mechanics.assignments.keys import deploy_job
 from mechanics.assignments.template import Template, parse_template, template_hash
 from mechanics.assignments.variants import Variant, deploy_seeds
+from mechanics.cache import ENGINE_VERSION
 from mechanics.spec import SpecError
 
 from .store import Store, attempt_of
@@ -253,7 +254,7 @@ def submit(
     stored, new = store.store_pending(assignment_id, student, part_id, answer, request_id)
     if not new and stored.status == "graded":
         return _submission_json(stored)
-    return _submission_json(_grade(store, stored, chosen.variant, part, policy, previous, run))
+    return _submission_json(_grade(store, stored, chosen, part, policy, previous, run))
 
 
 #: Verdicts already reached, by (scene, quantity, coordinate, answer): a class types the same
@@ -282,26 +283,40 @@ def forget_verdicts() -> None:
         _verdicts.clear()
 
 
-def _grade(store, stored, variant_json, part, policy, previous, run) -> Any:  # noqa: ANN001
-    variant = Variant.from_json(variant_json)
+def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: ANN001
+    variant = Variant.from_json(chosen.variant)
 
-    def budgeted(spec_text, quantity, coordinate, answer):  # noqa: ANN001, ANN202
-        key = (hashlib.sha256(spec_text.encode()).hexdigest(), quantity, coordinate, answer)
-        return _remembered(key, lambda: judge_in_pool(spec_text, quantity, coordinate, answer))
+    def budgeted(spec_text, quantity, coordinate, answer, near=None):  # noqa: ANN001, ANN202
+        digest = hashlib.sha256(spec_text.encode()).hexdigest()
+        key = (digest, quantity, coordinate, answer, near)
+        return _remembered(
+            key, lambda: judge_in_pool(spec_text, quantity, coordinate, answer, near)
+        )
 
-    def judge_in_pool(spec_text, quantity, coordinate, answer):  # noqa: ANN001, ANN202
+    def judge_in_pool(spec_text, quantity, coordinate, answer, near):  # noqa: ANN001, ANN202
         return run(
             grading.judge_job,
             spec_text,
             quantity,
             coordinate,
             answer,
+            near,
             what="checking this answer",
             budget="check",
             affinity=spec_text,
         )
 
     judged = grading.judge(variant, part, stored.answer, run=budgeted)
+    if variant.engine_version != ENGINE_VERSION and judged.decided:
+        keys = {k["part"]: k["plain"] for k in chosen.keys.get("parts", [])}
+        if not grading.key_still_holds(variant, part, keys.get(part["id"], ""), run=budgeted):
+            code = outcomes.code(part["quantity"], outcomes.CANNOT_DECIDE)
+            line = (
+                f"Cannot decide, because this engine (version {ENGINE_VERSION}) no longer agrees "
+                f"with the key this variant was made with (version {variant.engine_version}): "
+                "no attempt used; the instructor must redeploy."
+            )
+            judged = grading.Judged(code, [code], False, False, [line])
     try:
         attempt = grading.record(previous, stored.answer, judged, policy)
     except AttemptsExhausted:
@@ -319,7 +334,7 @@ def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> i
         if part is None:
             continue
         previous = [attempt_of(s) for s in store.attempts(assignment_id, sub.student, sub.part)]
-        _grade(store, sub, chosen.variant, part, _policy(row.template, part), previous, run)
+        _grade(store, sub, chosen, part, _policy(row.template, part), previous, run)
         count += 1
     return count
 

@@ -23,7 +23,7 @@ from mechanics.check import check
 from mechanics.derive import derivation_of_spec
 from mechanics.expr import ExprError
 
-from . import outcomes
+from . import oscillations, outcomes
 from .variants import Variant
 
 
@@ -68,18 +68,24 @@ class AttemptsExhausted(ValueError):
     """Every attempt of the part is used: the answer is refused, not judged."""
 
 
-def judge_job(spec_text: str, quantity: str, coordinate: str | None, answer: str) -> dict:
+def judge_job(
+    spec_text: str, quantity: str, coordinate: str | None, answer: str, near: float | None = None
+) -> dict:
     """The checker's verdict as JSON, in a pool worker (picklable, module level): the web layer
-    runs it under the check budget."""
+    runs it under the check budget. An equilibrium or a frequency is judged by oscillations.py."""
     d = derivation_of_spec(spec_text)
+    if quantity in oscillations.QUANTITIES:
+        return oscillations.judge(d, {"quantity": quantity, "near": near}, answer)
     return check(d, quantity, answer, coordinate).to_json(reveal=False)
 
 
-Runner = Callable[[str, str, str | None, str], dict]
+Runner = Callable[..., dict]
 
 
-def _local(spec_text: str, quantity: str, coordinate: str | None, answer: str) -> dict:
-    return judge_job(spec_text, quantity, coordinate, answer)
+def _local(
+    spec_text: str, quantity: str, coordinate: str | None, answer: str, near: float | None = None
+) -> dict:
+    return judge_job(spec_text, quantity, coordinate, answer, near)
 
 
 def judge(variant: Variant, part: dict[str, Any], answer: str, run: Runner = _local) -> Judged:
@@ -87,7 +93,9 @@ def judge(variant: Variant, part: dict[str, Any], answer: str, run: Runner = _lo
     a budgeted pool worker that raises BudgetExceeded)."""
     quantity = part["quantity"]
     try:
-        verdict = run(variant.spec_text(), quantity, part.get("coordinate"), answer)
+        verdict = run(
+            variant.spec_text(), quantity, part.get("coordinate"), answer, part.get("near")
+        )
     except ExprError as exc:
         code = outcomes.code(quantity, outcomes.UNREADABLE)
         return Judged(code, [code], False, False, [f"{exc.message}"])
@@ -112,7 +120,13 @@ def key_still_holds(
     if variant.engine_version == ENGINE_VERSION:
         return True
     try:
-        verdict = run(variant.spec_text(), part["quantity"], part.get("coordinate"), stored_key)
+        verdict = run(
+            variant.spec_text(),
+            part["quantity"],
+            part.get("coordinate"),
+            stored_key,
+            part.get("near"),
+        )
     except (ExprError, BudgetExceeded):
         return False
     return bool(verdict["correct"])

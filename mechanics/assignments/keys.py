@@ -15,6 +15,7 @@ from mechanics.check import expected_quantity
 from mechanics.derive import Derivation, derivation_of_spec
 from mechanics.expr import to_latex, to_plain
 
+from . import oscillations
 from .variants import Variant
 from .verify import Check, verify_key
 
@@ -85,6 +86,9 @@ def variant_keys(variant: Variant) -> VariantKeys:
     d = derivation(variant)
     out = []
     for part in variant.parts:
+        if part["quantity"] in oscillations.QUANTITIES:
+            out.append(_oscillation_key(d, part))
+            continue
         j = coordinate_index(d, part)
         expr = expected_quantity(d, part["quantity"], j)
         plain, latex = shown(d, part["quantity"], j, expr)
@@ -94,6 +98,20 @@ def variant_keys(variant: Variant) -> VariantKeys:
             check = Check("unconfirmed", f"the second route failed: {type(exc).__name__}")
         out.append(PartKey(part["id"], plain, latex, check))
     return VariantKeys(out)
+
+
+def _oscillation_key(d: Derivation, part: dict[str, Any]) -> PartKey:
+    """An equilibrium's or a frequency's key; one that cannot be made (an unstable equilibrium,
+    no root) is a key that cannot be confirmed, with the reason."""
+    try:
+        expr = oscillations.key(d, part)
+    except (ValueError, NotImplementedError, TypeError) as exc:
+        return PartKey(part["id"], "", "", Check("unconfirmed", str(exc)))
+    try:
+        check = oscillations.verify(d, part, expr)
+    except Exception as exc:
+        check = Check("unconfirmed", f"the second route failed: {type(exc).__name__}")
+    return PartKey(part["id"], to_plain(expr), to_latex(expr), check)
 
 
 def deploy_job(template_document: dict[str, Any], seed: str) -> dict[str, Any]:

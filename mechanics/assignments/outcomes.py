@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 #: The code's prefix for each checker quantity.
 PREFIX = {"T": "T", "V": "V", "L": "L", "Q": "Q", "eom": "eom", "accel": "accel", "momentum": "p"}
+PREFIX |= {"equilibrium": "q0", "frequency": "omega"}
 
 
 @dataclass(frozen=True)
@@ -106,6 +107,8 @@ KINDS: tuple[Kind, ...] = (
         r"(The rotation's|.*missing: a rigid body's T)",
         "a rigid body's ½ I ω² wrong or missing",
     ),
+    Kind("squared", r"This is ω², not ω", "a frequency's square (ω² for ω)"),
+    Kind("hertz", r"This is the frequency f = ω/2π", "f = ω/2π in hertz for the angular ω"),
     Kind("negated", r"Sign error: your answer is the negative", "the whole answer's sign"),
     Kind("sign_error", r"Sign error in", "one term's sign"),
     Kind(

@@ -40,7 +40,7 @@ from mechanics.spec import IDENT, SpecError, field_path, parse_spec
 
 Ident = Annotated[str, Field(pattern=IDENT)]
 #: The checker's quantities (mechanics/check.py QUANTITIES) a part may ask for.
-QUANTITIES = ("T", "V", "L", "Q", "eom", "accel", "momentum")
+QUANTITIES = ("T", "V", "L", "Q", "eom", "accel", "momentum", "equilibrium", "frequency")
 PER_COORDINATE = frozenset({"Q", "eom", "accel", "momentum"})
 #: Most values one parameter range may offer: a range past it needs a coarser step.
 MAX_VALUES = 1000
@@ -109,8 +109,10 @@ class Part(_Model):
     outcome code (``partial = { "L.up_to_total_derivative" = 0.5 }``)."""
 
     id: Ident
-    quantity: Literal["T", "V", "L", "Q", "eom", "accel", "momentum"]
+    quantity: Literal["T", "V", "L", "Q", "eom", "accel", "momentum", "equilibrium", "frequency"]
     coordinate: Ident | None = None
+    #: equilibrium / frequency: the equilibrium asked is the one nearest this value of q
+    near: float | None = None
     weight: float = Field(default=1.0, gt=0, le=100)
     prompt: str = Field(default="", max_length=400)
     partial: dict[str, Annotated[float, Field(ge=0, le=1)]] = {}
@@ -175,6 +177,14 @@ def parse_template(data: dict[str, Any]) -> Template:
     except SpecError as exc:
         raise SpecError([{**e, "field": f"scene_spec.{e['field']}"} for e in exc.errors]) from None
     errors = []
+    for i, part in enumerate(template.parts):
+        if part.quantity in ("equilibrium", "frequency") and len(spec.coordinates) != 1:
+            errors.append(
+                {
+                    "field": f"parts[{i}].quantity",
+                    "message": f"{part.quantity} parts need a scene with one coordinate",
+                }
+            )
     for name in template.parameters:
         if name not in spec.parameters:
             errors.append(
@@ -188,6 +198,8 @@ def parse_template(data: dict[str, Any]) -> Template:
                     "message": f"one of {', '.join(spec.coordinates)} is needed",
                 }
             )
+        if part.quantity in ("equilibrium", "frequency"):
+            continue
         if part.quantity not in PER_COORDINATE and part.coordinate is not None:
             errors.append(
                 {

@@ -7,7 +7,8 @@ import { api, askToken, el, forgetToken, inlineMath, say } from "./assignment_co
 const root = document.getElementById("parts");
 const id = root.dataset.assignment;
 const base = `/api/v1/assignments/${encodeURIComponent(id)}`;
-const WHAT = { T: "T", V: "V", L: "L", Q: "Q", eom: "the equation of motion", accel: "the acceleration", momentum: "the momentum" };
+const WHAT = { T: "T", V: "V", L: "L", Q: "Q", eom: "the equation of motion", accel: "the acceleration", momentum: "the momentum",
+  equilibrium: "the equilibrium", frequency: "the small-oscillation angular frequency ω" };
 
 function attemptsText(part) {
   const left = part.attempts_left === null ? "unlimited attempts" : `${part.attempts_left} attempt(s) left`;

@@ -181,3 +181,27 @@ def test_a_closed_assignment_refuses_submissions(deployed):
 def test_an_unreachable_database_says_so(unreachable_url):
     with pytest.raises(DatabaseUnavailable):
         engine_for(unreachable_url)
+
+
+def test_a_variant_from_another_engine_keeps_its_key_only_if_it_still_holds(deployed, url):
+    """A regrade on a newer engine: the stored key must still be judged right, else the part
+    cannot be decided (no attempt used) rather than graded against another key."""
+    from sqlalchemy import update
+
+    from app.assignments.models import VariantRow
+
+    chosen = deployed.variant_of("week1", "old")
+    keys = dict(chosen.keys)
+    keys["parts"] = [
+        {**k, "plain": "2*" + k["plain"]} if k["part"] == "T" else k for k in keys["parts"]
+    ]  # a key this engine does not agree with
+    variant = {**chosen.variant, "engine_version": -1}
+    with engine_for(url).begin() as c:
+        c.execute(
+            update(VariantRow).where(VariantRow.id == chosen.id).values(variant=variant, keys=keys)
+        )
+    fresh = Store(make_engine(url))
+    t = service.submit(fresh, "week1", "old", "T", RIGHT_T)
+    assert (t["code"], t["counted"]) == ("T.cannot_decide", False)
+    v = service.submit(fresh, "week1", "old", "V", RIGHT_V)  # its key still holds
+    assert (v["code"], v["score"]) == ("V.correct", 1.0)

@@ -115,3 +115,15 @@ def test_a_regrade_on_another_engine_keeps_the_key_only_if_it_still_holds(pendul
     assert grading.key_still_holds(old, old.parts[0], RIGHT_T)
     assert not grading.key_still_holds(old, old.parts[0], WRONG_T)
     assert grading.key_still_holds(pendulum_T, pendulum_T.parts[0], WRONG_T)  # same engine
+
+
+def test_an_equilibrium_and_a_frequency_are_graded():
+    """The hanging rod: θ₀ = 0 and ω = √(3 g / (2 l)) (by hand)."""
+    variant = one_part("physical_pendulum", "frequency")
+    a = attempt(variant, [], "sqrt(3*g/(2*l))", Policy())
+    assert (a.judged.code, a.score) == ("omega.correct", 1.0)
+    b = attempt(variant, [], "sqrt(g/l)", Policy())
+    assert (b.judged.code, b.score) == ("omega.wrong", 0.0)
+    rest = one_part("physical_pendulum", "equilibrium")
+    assert attempt(rest, [], "0", Policy()).judged.code == "q0.correct"
+    assert attempt(rest, [], "theta", Policy()).judged.code == "q0.unreadable"

@@ -90,3 +90,30 @@ def test_an_undeployable_variant_says_which_part_and_why(monkeypatch):
     keys = variant_keys(variant)
     assert not keys.deployable
     assert keys.why_not == "part 'p': key disagrees: the two routes differ"
+
+
+def test_a_frequency_key_is_the_hand_derived_one_and_verified():
+    """The rod about its end: I = m l²/3, K = m g l/2, so ω = √(3 g / (2 l)) (by hand)."""
+    from mechanics.assignments.oscillations import key, verify
+
+    variant = one_part("physical_pendulum", "frequency")
+    d = derivation(variant)
+    omega = key(d, variant.parts[0])
+    g, length = d.model.params["g"], d.model.params["l"]
+    assert sp.simplify(omega**2 - 3 * g / (2 * length)) == 0
+    assert verify(d, variant.parts[0], omega).ok
+    assert verify(d, variant.parts[0], 2 * omega).status == "disagrees"
+
+
+def test_a_frequency_about_an_unstable_equilibrium_is_never_deployed():
+    from mechanics.assignments.template import parse_template
+    from mechanics.assignments.variants import build_variant
+
+    document = {
+        "id": "t",
+        "title": "t",
+        "scene": "simple_pendulum",
+        "parts": [{"id": "w", "quantity": "frequency", "near": 3.0}],
+    }  # θ = π: on top
+    keys = variant_keys(build_variant(parse_template(document), "1"))
+    assert not keys.deployable and "not stable" in keys.why_not

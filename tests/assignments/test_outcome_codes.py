@@ -120,6 +120,9 @@ CASES = [
     ),
     ("T.wrong", "simple_pendulum", "T", None, TERMS_45),
     ("T.unreadable", "simple_pendulum", "T", None, "(m*l^2*theta_dot^2/2"),
+    # the pendulum's ω = √(g/l) by hand: ω² typed for ω, and f = ω/2π
+    ("omega.squared", "simple_pendulum", "frequency", None, "g/l"),
+    ("omega.hertz", "simple_pendulum", "frequency", None, "sqrt(g/l)/(2*pi)"),
 ]
 
 
