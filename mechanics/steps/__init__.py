@@ -274,8 +274,12 @@ def _trig_identities(c: sp.Expr) -> sp.Expr:
     if c.has(sp.tan, sp.cot, sp.sec, sp.csc) and sp.count_ops(c) <= SMALL_OPS:
         c = min((c, sp.trigsimp(c)), key=_size)  # small: trigsimp is cheap here
     if c.has(sp.sin, sp.cos):
-        candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
-        candidates += [sp.expand(TR10i(x)) for x in candidates]
+        candidates = [c, *_squares_rewritten(c)]
+        joined: dict[sp.Expr, sp.Expr] = {}  # TR10i once per distinct form
+        for x in candidates[:3]:
+            if x not in joined:
+                joined[x] = sp.expand(TR10i(x))
+        candidates += [joined[x] for x in candidates[:3]]
         candidates += [sp.expand(TR8(c)), sp.expand(sp.expand_trig(c))]
         c = TR10i(min(candidates, key=_size))
     return _factored(c)
@@ -288,9 +292,22 @@ def _trig_forms(c: sp.Expr) -> sp.Expr:
     six-link chain the smallest form was always c itself, TR6, TR10i or TR8 (products to sums)."""
     if not c.has(sp.sin, sp.cos):
         return c
-    candidates = [c, sp.expand(TR5(c)), sp.expand(TR6(c))]
+    candidates = [c, *_squares_rewritten(c)]
     candidates += [sp.expand(TR10i(c)), sp.expand(TR8(c))]
     return sp.expand(TR10i(min(candidates, key=_size)))
+
+
+def _squares_rewritten(c: sp.Expr) -> list[sp.Expr]:
+    """c with sin² → 1 − cos² (TR5) and with cos² → 1 − sin² (TR6), expanded. Without a square
+    of a sine or cosine both leave c as it is: then it is expanded once, not transformed twice
+    and the copy's TR10i taken thrice (a third of the trig pass on a 3-D chain's pieces)."""
+    if not any(p.exp.is_Integer and p.exp >= 2 for p in c.atoms(sp.Pow) if p.base.func in TRIG):
+        same = sp.expand(c)
+        return [same, same]
+    return [sp.expand(TR5(c)), sp.expand(TR6(c))]
+
+
+TRIG = (sp.sin, sp.cos)
 
 
 def _factored(c: sp.Expr) -> sp.Expr:
