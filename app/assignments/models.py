@@ -17,6 +17,7 @@ from sqlalchemy import (
     DateTime,
     Float,
     ForeignKey,
+    Index,
     Integer,
     String,
     Text,
@@ -75,7 +76,12 @@ class EnrolmentRow(Base):
 
 class SubmissionRow(Base):
     __tablename__ = "submissions"
-    __table_args__ = (UniqueConstraint("student", "request_id"),)
+    __table_args__ = (
+        UniqueConstraint("student", "request_id"),
+        # one row per counted attempt: two tabs submitting at once cannot both be attempt 2
+        # (migration 0002; NULL, an attempt not counted, may repeat)
+        Index("uq_submission_attempt", "assignment_id", "student", "part", "number", unique=True),
+    )
     id: Mapped[int] = mapped_column(Integer, primary_key=True, autoincrement=True)
     assignment_id: Mapped[str] = mapped_column(ForeignKey("assignments.id"), index=True)
     student: Mapped[str] = mapped_column(String(100), index=True)

@@ -18,6 +18,8 @@ from collections import Counter, OrderedDict, defaultdict
 from collections.abc import Callable
 from typing import Any
 
+from sqlalchemy.exc import IntegrityError
+
 from mechanics.assignments import grading, outcomes
 from mechanics.assignments.grading import AttemptsExhausted, Policy
 from mechanics.assignments.keys import deploy_job
@@ -33,6 +35,8 @@ from .store import Store, attempt_of
 RATE_ENV = "LAGRANGE_LAB_SUBMISSIONS_PER_MINUTE"
 DEFAULT_RATE = 30
 MAX_DEPLOY = 50
+#: A submission whose attempt number another one took at the same moment is renumbered this often.
+RENUMBER_TRIES = 5
 HISTOGRAM_BINS = 10
 
 Run = Callable[..., Any]  # run(job, *args, what=..., budget="check"|"derive", affinity=...)
@@ -317,11 +321,19 @@ def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: 
                 "no attempt used; the instructor must redeploy."
             )
             judged = grading.Judged(code, [code], False, False, [line])
-    try:
-        attempt = grading.record(previous, stored.answer, judged, policy)
-    except AttemptsExhausted:
-        attempt = grading.Attempt(stored.answer, judged, False, None, None, None)
-    return store.finish(stored.id, attempt)
+    for _ in range(RENUMBER_TRIES):
+        try:
+            attempt = grading.record(previous, stored.answer, judged, policy)
+        except AttemptsExhausted:
+            attempt = grading.Attempt(stored.answer, judged, False, None, None, None)
+        try:
+            return store.finish(stored.id, attempt)
+        except IntegrityError:  # another submission of this part took that attempt number
+            previous = [
+                attempt_of(s)
+                for s in store.attempts(stored.assignment_id, stored.student, part["id"])
+            ]
+    raise Refused(409, "answer", "another submission of this part is being scored; send it again")
 
 
 def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> int:

@@ -28,6 +28,8 @@ WHAT = {
     "eom": "the equation of motion",
     "accel": "the acceleration",
     "momentum": "the generalized momentum",
+    "equilibrium": "the equilibrium",
+    "frequency": "the small-oscillation angular frequency ω",
 }
 
 SERVER = '''"""PrairieLearn question code for the Lagrange Lab template {template_id!r}

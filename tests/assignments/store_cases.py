@@ -45,9 +45,11 @@ def test_migrations_make_the_tables_the_models_declare(url):
     for table in Base.metadata.sorted_tables:
         columns = {c["name"] for c in found.get_columns(table.name)}
         assert columns == {c.name for c in table.columns}, table.name
+    indexes = {i["name"] for i in found.get_indexes("submissions")}
+    assert "uq_submission_attempt" in indexes
     migrate(engine)  # twice: nothing to do, no error
     with engine.connect() as c:
-        assert c.execute(text("select version_num from alembic_version")).scalar() == "0001"
+        assert c.execute(text("select version_num from alembic_version")).scalar() == "0002"
 
 
 def test_a_token_is_stored_only_as_its_hash(store, url):
@@ -205,3 +207,27 @@ def test_a_variant_from_another_engine_keeps_its_key_only_if_it_still_holds(depl
     assert (t["code"], t["counted"]) == ("T.cannot_decide", False)
     v = service.submit(fresh, "week1", "old", "V", RIGHT_V)  # its key still holds
     assert (v["code"], v["score"]) == ("V.correct", 1.0)
+
+
+def test_two_tabs_submitting_at_once_get_two_attempt_numbers(deployed):
+    """Both read 'no attempt used' before either is scored; the database's unique attempt
+    number (migration 0002) makes the second renumber itself as attempt 2."""
+    import threading
+
+    both_judging = threading.Barrier(2, timeout=30)
+
+    def together(job, *args, **kwargs):
+        both_judging.wait()
+        return job(*args)
+
+    results = []
+
+    def tab(answer):
+        results.append(service.submit(deployed, "week1", "tabs", "T", answer, run=together))
+
+    threads = [threading.Thread(target=tab, args=(a,)) for a in ("m*l^2*theta_dot^2", RIGHT_T)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(60)
+    assert sorted(r["attempt"] for r in results) == [1, 2]
