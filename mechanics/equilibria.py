@@ -1967,19 +1967,12 @@ def _stability(
         raise _BeyondDoubles
     linear = {"M": M, "C": C, "K": K, "coordinates": [m.q[j] for j in idx]}
     n_free = len([j for j in free if j in idx]) + family_dim
-    names = [m.coordinate_names[j] for j in idx]
-    keep = [k for k, j in enumerate(idx) if j not in free]
     report = None  # the flat directions of K, judged by the higher-order test
     if at_rest is not None and not family_dim and power.kind != "no sign":
         forces = _rest_force_function(*(tuple(x) for x in (v.forcing, m.q, m.qd, m.qdd)), psyms)
+        keep = [k for k, j in enumerate(idx) if j not in free]
         report = flat.flat_at(at_rest, forces, q0, numbers, idx, keep, M, C, K)
-    n_free += report.level if report else 0
-    kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m), power=power)
-    shown, latex_names = _eigen_math(lam), [to_latex(m.q[j]) for j in idx]
-    single, potential = len(keep) == 1, _potential(_turning(m))
-    kind, reason = flat.amend(kind, reason, report, latex_names, shown, single, potential)
-    if report and report.level:  # the zero modes are a family's, not (only) free coordinates'
-        reason = reason.replace("free direction(s)", "free or family direction(s)")
+    kind, reason, lam, vecs = _judged(m, M, C, K, n_free, idx, free, power, report)
     freqs, modes, phases = [], [], []
     if kind != "unstable":
         freqs, modes, phases = _modes(M, C, K, lam, vecs, idx, n)
@@ -1994,6 +1987,22 @@ def _stability(
     if lost:
         _at_a_pole(verdict, m, full_M, at_rest, q0, numbers if at_rest else [], idx, lost, free)
     return verdict
+
+
+def _judged(m, M, C, K, n_free, idx, free, power, report):
+    """``_classify`` with the flat directions of K judged by the higher-order test: those
+    along which the equilibria form a family count with the free ones, the rest decide."""
+    names = [m.coordinate_names[j] for j in idx]
+    n_free += report.level if report else 0
+    kind, reason, lam, vecs = _classify(M, C, K, n_free, names, turning=_turning(m), power=power)
+    shown, latex_names = _eigen_math(lam), [to_latex(m.q[j]) for j in idx]
+    single = len([j for j in idx if j not in free]) == 1
+    kind, reason = flat.amend(
+        kind, reason, report, latex_names, shown, single, _potential(_turning(m))
+    )
+    if report and report.level:  # the zero modes are a family's, not (only) free coordinates'
+        reason = reason.replace("free direction(s)", "free or family direction(s)")
+    return kind, reason, lam, vecs
 
 
 def _turns_beside(at_rest, full_M, q0, numbers, idx, lost) -> bool:
