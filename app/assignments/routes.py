@@ -23,7 +23,7 @@ from starlette.concurrency import run_in_threadpool
 from mechanics.assignments import outcomes
 from mechanics.assignments.template import parse_template, parse_template_text, template_hash
 
-from . import service
+from . import report, service
 from .db import DatabaseUnavailable
 from .pages import router as pages_router
 from .service import Refused
@@ -304,7 +304,7 @@ def get_scores(
     assignment_id: str, http: Request, who: Annotated[Caller, Depends(instructor)]
 ) -> dict:
     service.regrade_pending(store(), assignment_id, pooled(http))
-    return service.scores(store(), assignment_id)
+    return report.scores(store(), assignment_id)
 
 
 @api.get("/{assignment_id}/report", responses=ERRORS, summary="The class report (JSON/CSV)")
@@ -320,9 +320,9 @@ def get_report(
     if format not in ("json", "csv"):
         raise fail(422, "format", "json or csv")
     service.regrade_pending(store(), assignment_id, pooled(http))
-    data = service.report(store(), assignment_id)
+    data = report.report(store(), assignment_id)
     if format == "csv":
-        return Response(service.report_csv(data), media_type="text/csv; charset=utf-8")
+        return Response(report.report_csv(data), media_type="text/csv; charset=utf-8")
     return data
 
 

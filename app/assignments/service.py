@@ -9,12 +9,10 @@ when asked (the routes call it for the assignment before reading scores).
 
 from __future__ import annotations
 
-import csv
 import hashlib
-import io
 import os
 import threading
-from collections import Counter, OrderedDict, defaultdict
+from collections import OrderedDict, defaultdict
 from collections.abc import Callable
 from typing import Any
 
@@ -37,7 +35,6 @@ DEFAULT_RATE = 30
 MAX_DEPLOY = 50
 #: A submission whose attempt number another one took at the same moment is renumbered this often.
 RENUMBER_TRIES = 5
-HISTOGRAM_BINS = 10
 
 Run = Callable[..., Any]  # run(job, *args, what=..., budget="check"|"derive", affinity=...)
 
@@ -128,7 +125,7 @@ def _undeployable(template: Template, seed: str, why: str) -> dict[str, Any]:
     }
 
 
-def _assignment(store: Store, assignment_id: str) -> Any:
+def assignment_row(store: Store, assignment_id: str) -> Any:
     row = store.assignment(assignment_id)
     if row is None:
         raise Refused(404, "assignment_id", f"no assignment '{assignment_id}'")
@@ -137,7 +134,7 @@ def _assignment(store: Store, assignment_id: str) -> Any:
 
 def preview(store: Store, assignment_id: str) -> dict[str, Any]:
     """For instructors: every variant with its keys and whether it is deployed (and why not)."""
-    row = _assignment(store, assignment_id)
+    row = assignment_row(store, assignment_id)
     return {
         "assignment_id": row.id,
         "template_id": row.template_id,
@@ -169,7 +166,7 @@ def _policy(template: dict[str, Any], part: dict[str, Any]) -> Policy:
 
 def student_view(store: Store, assignment_id: str, student: str) -> dict[str, Any]:
     """A student's own variant, without any key: the scene, the parts, attempts and scores."""
-    row = _assignment(store, assignment_id)
+    row = assignment_row(store, assignment_id)
     chosen = store.variant_of(assignment_id, student)
     if chosen is None:
         raise Refused(409, "assignment_id", "this assignment has no deployable variant")
@@ -338,7 +335,7 @@ def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: 
 
 def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> int:
     """Score every answer stored but not scored (its server stopped in between); how many."""
-    row = _assignment(store, assignment_id)
+    row = assignment_row(store, assignment_id)
     count = 0
     for sub in store.pending(assignment_id):
         chosen = store.variant_of(assignment_id, sub.student)
@@ -349,89 +346,3 @@ def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> i
         _grade(store, sub, chosen, part, _policy(row.template, part), previous, run)
         count += 1
     return count
-
-
-def scores(store: Store, assignment_id: str) -> dict[str, Any]:
-    """Each student's best penalised score per part and the weighted total."""
-    row = _assignment(store, assignment_id)
-    parts = row.template["parts"]
-    weights = [{"id": p["id"], "weight": p.get("weight", 1.0)} for p in parts]
-    by_student: dict[str, dict[str, list]] = defaultdict(lambda: defaultdict(list))
-    pending = Counter()
-    for sub in store.submissions(assignment_id):
-        if sub.status == "graded":
-            by_student[sub.student][sub.part].append(attempt_of(sub))
-        else:
-            pending[sub.student] += 1
-    seeds = {}
-    variants = {v.id: v.seed for v in store.variants(assignment_id)}
-    for e in store.enrolments(assignment_id):
-        seeds[e.student] = variants.get(e.variant_id)
-    students = []
-    for student in sorted(set(seeds) | set(by_student)):
-        part_scores = {p["id"]: grading.part_score(by_student[student][p["id"]]) for p in parts}
-        students.append(
-            {
-                "student": student,
-                "seed": seeds.get(student),
-                "parts": part_scores,
-                "attempts": {
-                    p["id"]: sum(1 for a in by_student[student][p["id"]] if a.counted)
-                    for p in parts
-                },
-                "pending": pending[student],
-                "total": round(grading.total_score(weights, part_scores), 6),
-            }
-        )
-    return {"assignment_id": assignment_id, "students": students}
-
-
-def report(store: Store, assignment_id: str) -> dict[str, Any]:
-    """Per part: the distribution of the students' scores (10 bins) and the count of each
-    outcome code over the decided submissions, with the share of students who had it once."""
-    table = scores(store, assignment_id)
-    row = _assignment(store, assignment_id)
-    students = table["students"]
-    codes: dict[str, Counter] = defaultdict(Counter)
-    who: dict[str, dict[str, set]] = defaultdict(lambda: defaultdict(set))
-    for sub in store.submissions(assignment_id):
-        if sub.status == "graded" and sub.decided and sub.code:
-            codes[sub.part][sub.code] += 1
-            who[sub.part][sub.code].add(sub.student)
-    parts = []
-    for p in row.template["parts"]:
-        values = [s["parts"][p["id"]] for s in students]
-        bins = [0] * HISTOGRAM_BINS
-        for v in values:
-            bins[min(HISTOGRAM_BINS - 1, int(v * HISTOGRAM_BINS))] += 1
-        parts.append(
-            {
-                "part": p["id"],
-                "students": len(values),
-                "mean": round(sum(values) / len(values), 6) if values else None,
-                "histogram": bins,
-                "codes": [
-                    {
-                        "code": code,
-                        "submissions": n,
-                        "students": len(who[p["id"]][code]),
-                        "share": round(len(who[p["id"]][code]) / len(values), 6) if values else 0.0,
-                    }
-                    for code, n in codes[p["id"]].most_common()
-                ],
-            }
-        )
-    return {"assignment_id": assignment_id, "students": len(students), "parts": parts}
-
-
-def report_csv(data: dict[str, Any]) -> str:
-    """The report as CSV: one row per (part, outcome code); cells never start with = + - @."""
-    out = io.StringIO()
-    writer = csv.writer(out)
-    writer.writerow(["part", "code", "submissions", "students", "share", "mean_score"])
-    for part in data["parts"]:
-        for c in part["codes"]:
-            writer.writerow(
-                [part["part"], c["code"], c["submissions"], c["students"], c["share"], part["mean"]]
-            )
-    return out.getvalue()

@@ -8,7 +8,7 @@ import pytest
 from sqlalchemy import inspect, select, text
 from sqlalchemy.exc import IntegrityError
 
-from app.assignments import service, tokens
+from app.assignments import report, service, tokens
 from app.assignments.db import DatabaseUnavailable, engine_for, make_engine, migrate
 from app.assignments.models import Base, SubmissionRow, TokenRow
 from app.assignments.store import Store
@@ -99,7 +99,7 @@ def test_the_answer_is_stored_before_it_is_judged(deployed):
     assert (row.student, row.answer, row.status) == ("s2", RIGHT_T, "pending")
     assert service.regrade_pending(deployed, "week1") == 1
     assert deployed.pending("week1") == []
-    assert service.scores(deployed, "week1")["students"][0]["parts"]["T"] == 1.0
+    assert report.scores(deployed, "week1")["students"][0]["parts"]["T"] == 1.0
 
 
 def test_a_retried_request_is_not_a_second_submission(deployed, url):
@@ -116,7 +116,7 @@ def test_penalties_and_best_score_across_the_database(deployed):
     right = service.submit(deployed, "week1", "s4", "V", RIGHT_V)
     assert (wrong["attempt"], wrong["score"], wrong["code"]) == (1, 0.0, "V.negated")
     assert (right["attempt"], right["score"]) == (2, 0.75)
-    (row,) = service.scores(deployed, "week1")["students"]
+    (row,) = report.scores(deployed, "week1")["students"]
     assert row["parts"] == {"T": 0.0, "V": 0.75}
     assert row["total"] == pytest.approx(0.75 * 3 / 4)
 
@@ -138,13 +138,13 @@ def test_the_report_counts_outcome_codes(deployed):
     service.submit(deployed, "week1", "b", "T", "m*l^2*theta_dot^2")
     service.submit(deployed, "week1", "b", "T", RIGHT_T)
     service.submit(deployed, "week1", "c", "T", "m*l^2*theta_dot^2/2 + exp(-10^6*theta_dot^2)")
-    report = service.report(deployed, "week1")
-    part = report["parts"][0]
+    data = report.report(deployed, "week1")
+    part = data["parts"][0]
     codes = {c["code"]: (c["submissions"], c["students"]) for c in part["codes"]}
     assert codes == {"T.wrong_factor": (2, 2), "T.correct": (1, 1)}  # cannot_decide: not counted
     assert part["students"] == 3
     assert part["histogram"][0] == 2 and part["histogram"][7] == 1  # 0, 0, 0.75
-    csv = service.report_csv(report)
+    csv = report.report_csv(data)
     assert "T,T.wrong_factor,2,2," in csv
 
 
