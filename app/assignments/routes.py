@@ -303,7 +303,7 @@ def post_student_tokens(
 def get_scores(
     assignment_id: str, http: Request, who: Annotated[Caller, Depends(instructor)]
 ) -> dict:
-    service.regrade_pending(store(), assignment_id, pooled(http))
+    service.regrade_pending(store(), assignment_id, pooled(http), service.PENDING_SECONDS)
     return report.scores(store(), assignment_id)
 
 
@@ -319,7 +319,7 @@ def get_report(
     the share of students who had it. ``?format=csv``: one row per (part, code)."""
     if format not in ("json", "csv"):
         raise fail(422, "format", "json or csv")
-    service.regrade_pending(store(), assignment_id, pooled(http))
+    service.regrade_pending(store(), assignment_id, pooled(http), service.PENDING_SECONDS)
     data = report.report(store(), assignment_id)
     if format == "csv":
         return Response(report.report_csv(data), media_type="text/csv; charset=utf-8")

@@ -14,6 +14,7 @@ import os
 import threading
 from collections import OrderedDict, defaultdict
 from collections.abc import Callable
+from datetime import UTC, datetime, timedelta
 from typing import Any
 
 from sqlalchemy.exc import IntegrityError
@@ -35,6 +36,10 @@ DEFAULT_RATE = 30
 MAX_DEPLOY = 50
 #: A submission whose attempt number another one took at the same moment is renumbered this often.
 RENUMBER_TRIES = 5
+#: The scores and the report judge answers left pending this long (past any check's budget, so
+#: not one a live request is still judging).
+PENDING_SECONDS = 30.0
+STARTED = datetime.now(UTC)
 
 Run = Callable[..., Any]  # run(job, *args, what=..., budget="check"|"derive", affinity=...)
 
@@ -333,11 +338,16 @@ def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: 
     raise Refused(409, "answer", "another submission of this part is being scored; send it again")
 
 
-def regrade_pending(store: Store, assignment_id: str, run: Run = local_run) -> int:
-    """Score every answer stored but not scored (its server stopped in between); how many."""
+def regrade_pending(
+    store: Store, assignment_id: str, run: Run = local_run, older_than: float = 0.0
+) -> int:
+    """Score every answer stored but not scored (its server stopped in between): those stored
+    before this process started, or at least ``older_than`` seconds ago (a younger one is most
+    likely being judged by the request that stored it); how many."""
     row = assignment_row(store, assignment_id)
     count = 0
-    for sub in store.pending(assignment_id):
+    before = max(datetime.now(UTC) - timedelta(seconds=older_than), STARTED)
+    for sub in store.pending(assignment_id, before):
         chosen = store.variant_of(assignment_id, sub.student)
         part = next((p for p in chosen.variant["parts"] if p["id"] == sub.part), None)
         if part is None:

@@ -284,9 +284,15 @@ class Store:
             return row
 
     @_reachable
-    def pending(self, assignment_id: str | None = None) -> list[SubmissionRow]:
+    def pending(
+        self, assignment_id: str | None = None, before: datetime | None = None
+    ) -> list[SubmissionRow]:
+        """Stored answers not yet scored (stored before ``before``, if given)."""
+        before = before or datetime.now(UTC)
         with self.session() as s:
-            query = select(SubmissionRow).where(SubmissionRow.status == "pending")
+            query = select(SubmissionRow).where(
+                SubmissionRow.status == "pending", SubmissionRow.created_at <= before
+            )
             if assignment_id is not None:
                 query = query.where(SubmissionRow.assignment_id == assignment_id)
             return list(s.scalars(query.order_by(SubmissionRow.id)))

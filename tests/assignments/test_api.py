@@ -244,3 +244,17 @@ def test_the_routes_are_documented_with_examples(client):
     submit = spec["paths"]["/api/v1/assignments/{assignment_id}/parts/{part_id}/submit"]["post"]
     assert {"401", "403", "409", "429", "503"} <= set(submit["responses"])
     assert spec["components"]["schemas"]["SubmitBody"]["examples"]
+
+
+def test_submissions_are_limited_per_student(client, pupils, deployed, monkeypatch):
+    monkeypatch.setenv("LAGRANGE_LAB_SUBMISSIONS_PER_MINUTE", "1")
+    url = "/api/v1/assignments/week1/parts/eom/submit"
+    answers = ("theta_ddot = 0", "l*theta_ddot = 0")
+    codes = [
+        client.post(url, json={"answer": a}, headers=pupils["s2"]).status_code for a in answers
+    ]
+    assert codes[-1] == 429
+    r = client.post(url, json={"answer": "g = 0"}, headers=pupils["s2"])
+    assert r.json()["detail"][0]["field"] == "answer"
+    other = client.get("/api/v1/assignments/week1/mine", headers=pupils["s1"])
+    assert other.status_code == 200  # reading is not limited, nor another student
