@@ -172,23 +172,29 @@ function showErrors(items) {
     div.className = "mark";
     div.style.top = `${10 + (line - 1) * LINE}px`;
     div.dataset.field = m.field;
-    if (k === 0) {
-      const note = Object.assign(document.createElement("span"), { textContent: `← ${m.field}: ${m.message}` });
-      const text = $("spec").value.split("\n")[line - 1] || "";
-      note.style.left = `${10 + (text.length + 2) * charWidth()}px`;
-      div.append(note);
-    }
+    if (k === 0) div.title = `${m.field}: ${m.message}`;
     return div;
   })));
   $("line-marks").replaceChildren(inner);
+  codeNote();
   numberLines();
   if (marks.length) reveal(marks[0], false);
 }
 
-function charWidth() {
-  const ctx = document.createElement("canvas").getContext("2d");
-  ctx.font = getComputedStyle($("spec")).font;
-  return ctx.measureText("0000000000").width / 10;
+/** The first problem in a line of its own right under the code, never over it: a note drawn at
+ * a line's end covered the code after it once the text scrolled sideways, and ran off a phone's
+ * screen (issue 26, item 4). The marked lines and the gutter show where; the Problems list all. */
+function codeNote() {
+  const note = $("code-note");
+  if (!note) return;
+  note.hidden = marks.length === 0;
+  if (!marks.length) { note.replaceChildren(); return; }
+  const m = marks[0];
+  const go = Object.assign(document.createElement("button"), { type: "button", className: "small", textContent: `line ${m.lines[0]}` });
+  go.addEventListener("click", () => reveal(m));
+  const more = marks.length > 1 ? ` (and ${marks.length - 1} more under Problems)` : "";
+  note.replaceChildren(go, " ", Object.assign(document.createElement("code"), { textContent: m.field || "spec" }),
+    `: ${m.message}${more}`);
 }
 
 function reveal(m, focus = true) {
@@ -220,6 +226,7 @@ async function derive() {
     marks[0].lines = [e.line];
     $("spec-errors").querySelector(".where").textContent = `line ${e.line}`;
     $("line-marks").querySelector(".mark").style.top = `${10 + (e.line - 1) * LINE}px`;
+    codeNote();
     numberLines();
     return;
   }

@@ -273,12 +273,18 @@ def test_editor_shows_a_field_level_error_then_runs_a_good_spec(server, page, ar
     error = p.locator("#spec-errors li[data-field='bodies[0].mass']")
     error.wait_for(timeout=30_000)
     assert "lenght" in error.inner_text()
-    # the line of the field is marked in the text, with the message beside it
+    # the line of the field is marked in the text; the message is right under the code, never
+    # over it (issue 26, item 4: a note drawn at the line's end covered code)
     line = spec.split("\n").index(next(x for x in spec.split("\n") if '"lenght"' in x)) + 1
     assert f"line {line}" in error.inner_text()
     assert p.inner_text("#gutter .error") == str(line)
-    mark = p.locator("#line-marks .mark[data-field='bodies[0].mass'] span")
-    assert mark.is_visible() and "lenght" in mark.inner_text()
+    assert p.locator("#line-marks .mark[data-field='bodies[0].mass']").first.is_visible()
+    assert p.locator("#line-marks span").count() == 0  # no text over the code
+    note = p.locator("#code-note")
+    assert note.is_visible() and "lenght" in note.inner_text()
+    assert f"line {line}" in note.inner_text()
+    code, under = p.locator("#code").bounding_box(), note.bounding_box()
+    assert under["y"] >= code["y"] + code["height"] - 1
     p.screenshot(path=str(artifacts / "editor-error.png"))
     # a spec that is not even JSON names the line it breaks on
     p.fill("#spec", spec.replace('"kind": "particle",', '"kind": "particle"'))
