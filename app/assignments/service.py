@@ -169,6 +169,29 @@ def _policy(template: dict[str, Any], part: dict[str, Any]) -> Policy:
     )
 
 
+#: The derivation's steps (mechanics/derive.py STEPS) and the parts each would give away: in a
+#: graded assignment a step is shown once every part it gives away has been answered (an attempt
+#: used), or the assignment is closed; in practice, every step at once.
+STEP_GIVES = {
+    "fbd": set(),
+    "coordinates": set(),
+    "kinematics": {"T", "L", "momentum"},
+    "energy": {"T", "V", "L", "momentum", "equilibrium", "frequency"},
+    "forces": {"Q", "eom", "accel"},
+    "lagrange": {"eom", "accel", "equilibrium", "frequency"},
+    "matrix": {"T", "eom", "accel", "frequency"},
+    "conserved": {"T", "V", "L", "momentum"},
+}
+
+
+def shown_steps(mode: str, closed: bool, parts: list[dict[str, Any]]) -> list[str]:
+    """The derivation steps a student may see now (see STEP_GIVES)."""
+    if mode == "practice" or closed:
+        return list(STEP_GIVES)
+    open_quantities = {p["quantity"] for p in parts if not p["attempts_used"]}
+    return [step for step, gives in STEP_GIVES.items() if not gives & open_quantities]
+
+
 def student_view(store: Store, assignment_id: str, student: str) -> dict[str, Any]:
     """A student's own variant, without any key: the scene, the parts, attempts and scores."""
     row = assignment_row(store, assignment_id)
@@ -208,6 +231,7 @@ def student_view(store: Store, assignment_id: str, student: str) -> dict[str, An
         "parameters": variant["parameters"],
         "parts": parts,
         "score": grading.total_score(variant["parts"], scores),
+        "steps_shown": shown_steps(row.template.get("mode", "graded"), row.closed, parts),
     }
 
 

@@ -1,7 +1,8 @@
 // A student's assignment page: their own variant (never its keys), each part with an answer box,
 // the checker's feedback, attempts left and the score.
 
-import { typeset } from "./api.js";
+import { postJSON, typeset } from "./api.js";
+import { renderSteps } from "./derivation.js";
 import { api, askToken, el, forgetToken, inlineMath, say } from "./assignment_common.js";
 
 const root = document.getElementById("parts");
@@ -35,7 +36,7 @@ function renderPart(part) {
   box.append(form, line, list);
   if (part.last) {
     input.value = part.last.answer;
-    feedbackList(list, part.last.feedback);
+    feedbackList(list, [`${part.last.code} (last answer)`, ...part.last.feedback]);
   }
   if (part.attempts_left === 0) button.disabled = true;
   form.addEventListener("submit", async (event) => {
@@ -57,6 +58,29 @@ function renderPart(part) {
   return box;
 }
 
+let derivation = null;
+let shownKey = "";
+
+/** The derivation's steps this student may see now (the server says which: all in practice,
+ * in a graded assignment only those that give no unanswered part away). */
+async function showDerivation(mine) {
+  const panel = document.getElementById("derivation-panel");
+  const key = mine.steps_shown.join(",");
+  if (key === shownKey) return;
+  shownKey = key;
+  derivation ||= await postJSON("/api/v1/derive", { scene: mine.scene });
+  const steps = derivation.steps.filter((s) => mine.steps_shown.includes(s.id) && s.id !== "fbd");
+  const hidden = derivation.steps.length - steps.length - 1;
+  document.getElementById("derivation-note").textContent = hidden > 0
+    ? `${hidden} step(s) stay hidden until you have answered the parts they would give away.`
+    : "";
+  renderSteps(document.getElementById("steps"), { ...derivation, steps }, {
+    target: () => ({ scene: mine.scene }), coordinates: mine.scene.coordinates,
+  });
+  panel.hidden = false;
+  typeset([panel]);
+}
+
 async function refresh() {
   const mine = await api(`${base}/mine`);
   document.getElementById("title").textContent = mine.title;
@@ -70,12 +94,14 @@ async function refresh() {
   document.getElementById("variant").hidden = false;
   root.replaceChildren(...mine.parts.map(renderPart));
   if (mine.closed) say("This assignment is closed: answers are no longer taken.");
+  await showDerivation(mine);
 }
 
 /** After a submission: the scores and attempts left, without redrawing the parts. */
 async function update() {
   const mine = await api(`${base}/mine`);
   document.getElementById("total").textContent = mine.score.toFixed(2);
+  await showDerivation(mine);
   for (const part of mine.parts) {
     document.getElementById(`score-${part.id}`).textContent = attemptsText(part);
     document.querySelector(`#part-${part.id} button`).disabled = part.attempts_left === 0 || mine.closed;

@@ -258,3 +258,15 @@ def test_submissions_are_limited_per_student(client, pupils, deployed, monkeypat
     assert r.json()["detail"][0]["field"] == "answer"
     other = client.get("/api/v1/assignments/week1/mine", headers=pupils["s1"])
     assert other.status_code == 200  # reading is not limited, nor another student
+
+
+def test_a_graded_assignment_shows_only_the_steps_that_give_no_open_part_away():
+    from app.assignments.service import shown_steps
+
+    parts = [{"quantity": "T", "attempts_used": 0}, {"quantity": "eom", "attempts_used": 0}]
+    assert shown_steps("graded", False, parts) == ["fbd", "coordinates"]
+    parts[0]["attempts_used"] = 1  # T answered: velocities and energies may be seen, not forces
+    shown = shown_steps("graded", False, parts)
+    assert {"kinematics", "energy"} <= set(shown) and not {"forces", "lagrange"} & set(shown)
+    assert "lagrange" in shown_steps("graded", True, parts)  # closed: everything
+    assert "lagrange" in shown_steps("practice", False, parts)

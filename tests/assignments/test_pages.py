@@ -34,7 +34,8 @@ def site(tmp_path_factory):
     url = f"sqlite:///{folder / 'assignments.sqlite3'}"
     store = Store(engine_for(url))
     teacher = tokens.create(store, "instructor", "ada")
-    pupil = tokens.create(store, "student", "s1")
+    pupils = {w: tokens.create(store, "student", f"s{w}") for w in (1300, 1024, 390)}
+    pupil = pupils[1300]
     port = free_port()
     env = {**os.environ, "LAGRANGE_LAB_DATABASE_URL": url, "LAGRANGE_LAB_POOL_WORKERS": "2"}
     command = [
@@ -55,7 +56,13 @@ def site(tmp_path_factory):
             timeout=300,
         )
         assert r.status_code == 201, r.text
-        yield {"base": base, "teacher": teacher, "pupil": pupil, "preview": r.json()}
+        yield {
+            "base": base,
+            "teacher": teacher,
+            "pupil": pupil,
+            "pupils": pupils,
+            "preview": r.json(),
+        }
     forget_engines()
 
 
@@ -95,7 +102,8 @@ def no_sideways_scroll(page) -> bool:
 def test_a_student_answers_a_part_and_sees_code_feedback_and_score(site, browser, width, height):
     ctx, page, errors = new_page(browser, width, height)
     try:
-        page.goto(f"{site['base']}/assignments/week1#token={site['pupil']}")
+        pupil = site["pupils"][width]  # a student of their own: no earlier answer on the page
+        page.goto(f"{site['base']}/assignments/week1#token={pupil}")
         page.wait_for_selector("#answer-T")
         assert "token=" not in page.url  # the fragment is taken out of the address bar
         mine = httpx.get(
@@ -109,6 +117,9 @@ def test_a_student_answers_a_part_and_sees_code_feedback_and_score(site, browser
         first = page.text_content("#part-T .feedback li")
         assert first.startswith("T.wrong_factor"), first
         page.wait_for_function("document.querySelector('#score-T').textContent.includes(' used')")
+        page.wait_for_selector("#steps li.step")
+        shown = page.eval_on_selector_all("#steps li.step", "els => els.map(e => e.dataset.step)")
+        assert "energy" not in shown and "lagrange" not in shown  # graded: T, V, L, eom open
         assert no_sideways_scroll(page)
         assert serious(page) == []
         assert errors == []
