@@ -170,8 +170,9 @@ def _policy(template: dict[str, Any], part: dict[str, Any]) -> Policy:
 
 
 #: The derivation's steps (mechanics/derive.py STEPS) and the parts each would give away: in a
-#: graded assignment a step is shown once every part it gives away has been answered (an attempt
-#: used), or the assignment is closed; in practice, every step at once.
+#: graded assignment a step is shown once every part it gives away is done (right, or no attempt
+#: left: shown after one wrong attempt, the key would make the retry free), or the assignment is
+#: closed; in practice, every step at once.
 STEP_GIVES = {
     "fbd": set(),
     "coordinates": set(),
@@ -188,7 +189,7 @@ def shown_steps(mode: str, closed: bool, parts: list[dict[str, Any]]) -> list[st
     """The derivation steps a student may see now (see STEP_GIVES)."""
     if mode == "practice" or closed:
         return list(STEP_GIVES)
-    open_quantities = {p["quantity"] for p in parts if not p["attempts_used"]}
+    open_quantities = {p["quantity"] for p in parts if not p["solved"] and p["attempts_left"] != 0}
     return [step for step, gives in STEP_GIVES.items() if not gives & open_quantities]
 
 
@@ -217,6 +218,7 @@ def student_view(store: Store, assignment_id: str, student: str) -> dict[str, An
                 "prompt": part.get("prompt", ""),
                 "attempts_used": sum(1 for a in attempts if a.counted),
                 "attempts_left": grading.attempts_left(attempts, policy),
+                "solved": any(a.counted and a.raw == 1.0 for a in attempts),
                 "score": scores[part["id"]],
                 "last": None if last is None else _submission_json(last),
             }

@@ -62,7 +62,7 @@ let derivation = null;
 let shownKey = "";
 
 /** The derivation's steps this student may see now (the server says which: all in practice,
- * in a graded assignment only those that give no unanswered part away). */
+ * in a graded assignment only those that give away no part still open). */
 async function showDerivation(mine) {
   const panel = document.getElementById("derivation-panel");
   const key = mine.steps_shown.join(",");
@@ -72,7 +72,7 @@ async function showDerivation(mine) {
   const steps = derivation.steps.filter((s) => mine.steps_shown.includes(s.id) && s.id !== "fbd");
   const hidden = derivation.steps.length - steps.length - 1;
   document.getElementById("derivation-note").textContent = hidden > 0
-    ? `${hidden} step(s) stay hidden until you have answered the parts they would give away.`
+    ? `${hidden} step(s) stay hidden until the parts they would give away are done (right, or out of attempts).`
     : "";
   renderSteps(document.getElementById("steps"), { ...derivation, steps }, {
     target: () => ({ scene: mine.scene }), coordinates: mine.scene.coordinates,

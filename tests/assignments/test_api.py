@@ -263,9 +263,14 @@ def test_submissions_are_limited_per_student(client, pupils, deployed, monkeypat
 def test_a_graded_assignment_shows_only_the_steps_that_give_no_open_part_away():
     from app.assignments.service import shown_steps
 
-    parts = [{"quantity": "T", "attempts_used": 0}, {"quantity": "eom", "attempts_used": 0}]
+    parts = [
+        {"quantity": "T", "solved": False, "attempts_left": 2},
+        {"quantity": "eom", "solved": False, "attempts_left": None},
+    ]
     assert shown_steps("graded", False, parts) == ["fbd", "coordinates"]
-    parts[0]["attempts_used"] = 1  # T answered: velocities and energies may be seen, not forces
+    parts[0]["attempts_left"] = 1  # one wrong attempt: T is not done, nothing more is shown
+    assert shown_steps("graded", False, parts) == ["fbd", "coordinates"]
+    parts[0]["solved"] = True  # T right (at 0.9): velocities and energies shown, not the forces
     shown = shown_steps("graded", False, parts)
     assert {"kinematics", "energy"} <= set(shown) and not {"forces", "lagrange"} & set(shown)
     assert "lagrange" in shown_steps("graded", True, parts)  # closed: everything

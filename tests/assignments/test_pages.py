@@ -152,7 +152,7 @@ def test_the_instructor_previews_keys_and_draws_the_report(site, browser, width,
         assert page.locator(".assignment-preview tr").count() == 3  # header + 2 variants
         page.click("#report-button")
         page.wait_for_selector("#hist-T .main-svg", timeout=60_000)
-        assert page.is_visible("#csv")
+        page.wait_for_selector("#csv", state="visible")
         assert no_sideways_scroll(page)
         assert serious(page) == []
         assert errors == []
