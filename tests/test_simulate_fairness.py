@@ -23,7 +23,16 @@ from app.derivations import FairGate
 from mechanics.budget import BudgetExceeded
 
 #: The heavy request of the issue: scipy's DOP853 at rtol 1e-14 over 1000 s (minutes of work).
-HEAVY = {"scene_id": "double_pendulum", "t_end": 1000, "fps": 20, "rtol": 1e-14, "atol": 1e-16}
+#: A run that spends its whole wall-time budget: scipy's DOP853 stepped in Python, named, since the
+#: default (dop853_c, issue 24) takes these steps in C and may finish 1000 s within the budget.
+HEAVY = {
+    "scene_id": "double_pendulum",
+    "t_end": 1000,
+    "fps": 20,
+    "rtol": 1e-14,
+    "atol": 1e-16,
+    "method": "DOP853",
+}
 #: What a student's page asks for: a pendulum over 10 s in C.
 SMALL = {"scene_id": "simple_pendulum", "t_end": 10, "method": "dop853_c", "rtol": 1e-9}
 FLOOD = 45
