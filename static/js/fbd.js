@@ -88,10 +88,17 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   const used = new Set();
   const drawn = []; // [body, direction]: arrows alike in direction are drawn side by side
   const labels = []; // {tip, d, text, sub, color}: placed once all arrows are drawn
-  for (const b of geom.bodies) {
+  const bodyBoxes = geom.bodies.map((b) => { // what each body covers on the drawing
     const [x, y] = view.project(geom.at(b.name, i));
-    occupied.push([x - 12, y - 12, x + 12, y + 12]);
-  }
+    const half = bodyHalf(geom, view, b.name);
+    return [x - half, y - half, x + half, y + half];
+  });
+  // labels keep off a body; a wheel's face (drawn faintly, large) may carry them, its centre not
+  occupied.push(...bodyBoxes.map((b, k) => {
+    if (!geom.wheels?.has(geom.bodies[k].name)) return b;
+    const cx = (b[0] + b[2]) / 2, cy = (b[1] + b[3]) / 2;
+    return [cx - 12, cy - 12, cx + 12, cy + 12];
+  }));
   for (const f of arrows) {
     if (f.size < 1e-9 * biggest || !result.positions[f.on]) continue;
     const p = f.at || geom.at(f.on, i);
@@ -108,7 +115,14 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
       const alike = drawn.filter(([at, e]) => at === where && e[0] * d[0] + e[1] * d[1] > 0.94).length;
       drawn.push([where, d]);
       const side = alike ? (alike % 2 ? 1 : -1) * 8 * Math.ceil(alike / 2) : 0;
-      const foot = [x - d[1] * side, y + d[0] * side];
+      // from the body's edge, not its centre: a short arrow (friction, a push) lay under the body
+      // drawn over its foot (issue 26, item 5); slid along its own line, its line of action stays
+      // (a force at a contact point, f.at, already starts on the body's surface)
+      const centre = geom.P[f.on] ? geom.at(f.on, i) : null;
+      const contact = f.at && !(centre && f.at.every((v, k) => Math.abs(v - centre[k]) <= 1e-9 * (1 + Math.abs(v))));
+      const own = contact ? null : geom.bodies.findIndex((b) => b.name === f.on);
+      const foot = own === null || own < 0 ? [x - d[1] * side, y + d[0] * side]
+        : clearOf(bodyBoxes[own], [x - d[1] * side, y + d[0] * side], d, geom.wheels?.has(f.on));
       const tip = [foot[0] + d[0] * len, foot[1] + d[1] * len];
       shapes.push({ t: "arrow", a: foot, b: tip, color, width: 2.5, head: 10, dash: f.dashed ? [5, 3] : undefined });
       // the arrow itself is taken: no label of another force may sit on it
@@ -117,7 +131,8 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
         occupied.push([px - 3, py - 3, px + 3, py + 3]);
       }
       const { text, sub } = f.symbol ? { text: f.symbol[0], sub: f.symbol[1] } : labelParts(f.label);
-      measured.push({ label: sub ? `${text}_${sub}` : text, on: f.on, size: f.size, length: len, short: tiny });
+      measured.push({ label: sub ? `${text}_${sub}` : text, on: f.on, size: f.size, length: len, short: tiny,
+        foot: foot.map((v) => Number(v.toFixed(1))), tip: tip.map((v) => Number(v.toFixed(1))) });
       if (tiny && !short.includes(sub ? `${text}_${sub}` : text)) short.push(sub ? `${text}_${sub}` : text);
       const key = `${text}_${sub}@${f.on}`;
       if (used.has(key)) continue;
@@ -145,6 +160,8 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   svg.dataset.frame = String(i);
   svg.dataset.arrows = String(arrows.filter((a) => a.size >= 1e-9 * biggest).length);
   svg.dataset.scale = JSON.stringify({ px_per_newton: scale.pxPerNewton, arrows: measured });
+  svg.dataset.bodies = JSON.stringify(bodyBoxes.map((b, k) => ({ name: geom.bodies[k].name,
+    box: b.map((v) => Number(v.toFixed(1))), wheel: Boolean(geom.wheels?.has(geom.bodies[k].name)) })));
   const named = arrows.filter((a) => a.kind === "constraint" && a.size >= 1e-9 * biggest);
   svg.dataset.constraints = JSON.stringify(named.map(({ name, on, at, x, y, z, what }) =>
     ({ name, on, what, at: at || geom.at(on, i), centre: geom.at(on, i), force: [x, y, z] })));
@@ -155,6 +172,33 @@ export function drawFBD(svg, spec, result, parameters, i, angles = {}, placed = 
   legend.short = run.short;
   legend.now = { kinds: [...kinds], short };
   return legend;
+}
+
+/** Half the size (px) of the square a body covers on the diagram: its drawn radius (a block is
+ * drawn a little wider than a bob), a wheel its rim, and a pixel of margin; at least 12. */
+function bodyHalf(geom, view, name) {
+  const r = 8 * (geom.size[name] || 1);
+  const wheel = geom.wheels?.has(name) ? geom.wheels.get(name) * view.scale : 0;
+  return Math.max(12, 1.45 * r + 2, wheel + 2);
+}
+
+/** `foot` moved along `d` until it is out of the body's `box` (a wheel: out of its rim, the
+ * circle in the box), one pixel beyond; a foot outside stays. */
+function clearOf(box, foot, d, round = false) {
+  const [x, y] = foot;
+  const cx = (box[0] + box[2]) / 2, cy = (box[1] + box[3]) / 2, half = (box[2] - box[0]) / 2;
+  let t;
+  if (round) { // |foot + t d − c| = half, the larger root
+    const ox = x - cx, oy = y - cy, b = ox * d[0] + oy * d[1], c = ox * ox + oy * oy - half * half;
+    if (c >= 0) return foot;
+    t = -b + Math.sqrt(b * b - c);
+  } else {
+    if (!(x > box[0] && x < box[2] && y > box[1] && y < box[3])) return foot;
+    t = Math.min(...[0, 1].map((k) => (d[k] > 1e-9 ? (box[k + 2] - foot[k]) / d[k]
+      : d[k] < -1e-9 ? (box[k] - foot[k]) / d[k] : Infinity)));
+  }
+  if (!Number.isFinite(t)) return foot;
+  return [x + d[0] * (t + 1), y + d[1] * (t + 1)];
 }
 
 /** The lecture hall's least label size (CSS px on screen): lecture mode enlarges a drawing's labels
