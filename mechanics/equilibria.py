@@ -187,7 +187,7 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
     # one sentence per reason, over every side of the springs' anchors
     warnings += [_numeric_note(why, roots) for why, roots in numeric_only.items()]
     found.sort(key=lambda vr: [abs(vr[1].numeric.get(j, 0.0)) for j in range(len(m.q))])
-    crowded = _crowded([r.numeric for _, r in found], periods)
+    crowded = families_.crowded([r.numeric for _, r in found], periods)
     free = sorted({j for j, c in enumerate(conditions) if c == 0} | set(idle))
     results, verdicts = [], []
     left_out = False  # balanced where the system has no state: "never balance" would be false
@@ -311,24 +311,6 @@ def equilibria(d: Derivation, parameters: dict[str, float] | None = None) -> dic
             else "No equilibrium: the forces at rest never balance at these parameters."
         )
     return {"steps": [s.to_json() for s in steps], "equilibria": results, "warnings": warnings}
-
-
-def _crowded(points: list[dict[int, float]], periods: dict[int, float]) -> bool:
-    """Do some of the equilibria found lie next to each other (1e-3 apart), as points of a
-    continuum the search samples do? A 6-link chain's 2⁶ = 64 isolated ones do not: a
-    'continuum?' there was a false hint."""
-    points = points[:100]
-    for i, a in enumerate(points):
-        for b in points[:i]:
-            gap = 0.0
-            for j in set(a) | set(b):
-                diff = a.get(j, 0.0) - b.get(j, 0.0)
-                if j in periods:
-                    diff = math.remainder(diff, periods[j])
-                gap = max(gap, abs(diff) / max(1.0, abs(a.get(j, 0.0))))
-            if gap < 1e-3:
-                return True
-    return False
 
 
 #: The order in which one configuration's verdicts are kept: the most cautious first.

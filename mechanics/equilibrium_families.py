@@ -15,6 +15,7 @@ orientation is not in its position).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -135,3 +136,21 @@ class Continua:
                 + ", ".join(f"{k} = {x:.4g}" for k, x in result["q"].items())
                 + f", and every point of it has the same verdict ({v.kind})."
             )
+
+
+def crowded(points: list[dict[int, float]], periods: dict[int, float]) -> bool:
+    """Do some of the equilibria found lie next to each other (1e-3 apart), as points of a
+    continuum the search samples do? A 6-link chain's 2⁶ = 64 isolated ones do not: a
+    'continuum?' there was a false hint."""
+    points = points[:100]
+    for i, a in enumerate(points):
+        for b in points[:i]:
+            gap = 0.0
+            for j in set(a) | set(b):
+                diff = a.get(j, 0.0) - b.get(j, 0.0)
+                if j in periods:
+                    diff = math.remainder(diff, periods[j])
+                gap = max(gap, abs(diff) / max(1.0, abs(a.get(j, 0.0))))
+            if gap < 1e-3:
+                return True
+    return False
