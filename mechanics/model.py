@@ -18,7 +18,8 @@ from sympy.physics.mechanics import Particle, RigidBody, inertia
 from sympy.physics.vector import Point, ReferenceFrame, Vector, dynamicsymbols
 
 from mechanics.expr import parse, to_plain
-from mechanics.spec import FramePosition, SceneSpec, nonnegative_parameters, parse_spec
+from mechanics.spec import FramePosition, SceneSpec, parse_spec
+from mechanics.spec_names import nonnegative_parameters
 
 T = dynamicsymbols._t
 
