@@ -4,7 +4,7 @@ PostgreSQL (issue 27's "done when").
 The server is ``python -m app serve`` started as a subprocess on a free loopback port, with its own
 data folder (or ``--database-url``). An instructor token is made with ``lagrange-lab token
 create``, a shipped template is deployed, and every student (its own loopback source address, as
-mechanics/bench_load.py does) opens their variant and submits every part twice (a wrong answer,
+benchmarks/load.py does) opens their variant and submits every part twice (a wrong answer,
 then the key), with think time between. The same class then runs again posting the same answers to
 ``/api/v1/check`` (no grading, no database): the two p95s side by side. ``--kill-at S`` kills the
 server (SIGKILL) S seconds into the graded run and restarts it; students retry a failed submit

@@ -318,21 +318,21 @@ def forget_verdicts() -> None:
 def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: ANN001
     variant = Variant.from_json(chosen.variant)
 
-    def budgeted(spec_text, quantity, coordinate, answer, near=None):  # noqa: ANN001, ANN202
+    def budgeted(spec_text, quantity, coordinate, answer, options=()):  # noqa: ANN001, ANN202
         digest = hashlib.sha256(spec_text.encode()).hexdigest()
-        key = (digest, quantity, coordinate, answer, near)
+        key = (digest, quantity, coordinate, answer, options)
         return _remembered(
-            key, lambda: judge_in_pool(spec_text, quantity, coordinate, answer, near)
+            key, lambda: judge_in_pool(spec_text, quantity, coordinate, answer, options)
         )
 
-    def judge_in_pool(spec_text, quantity, coordinate, answer, near):  # noqa: ANN001, ANN202
+    def judge_in_pool(spec_text, quantity, coordinate, answer, options):  # noqa: ANN001, ANN202
         return run(
             grading.judge_job,
             spec_text,
             quantity,
             coordinate,
             answer,
-            near,
+            options,
             what="checking this answer",
             budget="check",
             affinity=spec_text,

@@ -69,13 +69,13 @@ class AttemptsExhausted(ValueError):
 
 
 def judge_job(
-    spec_text: str, quantity: str, coordinate: str | None, answer: str, near: float | None = None
+    spec_text: str, quantity: str, coordinate: str | None, answer: str, options: tuple = ()
 ) -> dict:
     """The checker's verdict as JSON, in a pool worker (picklable, module level): the web layer
     runs it under the check budget. An equilibrium or a frequency is judged by oscillations.py."""
     d = derivation_of_spec(spec_text)
     if quantity in oscillations.QUANTITIES:
-        return oscillations.judge(d, {"quantity": quantity, "near": near}, answer)
+        return oscillations.judge(d, {"quantity": quantity, **dict(options)}, answer)
     return check(d, quantity, answer, coordinate).to_json(reveal=False)
 
 
@@ -83,9 +83,14 @@ Runner = Callable[..., dict]
 
 
 def _local(
-    spec_text: str, quantity: str, coordinate: str | None, answer: str, near: float | None = None
+    spec_text: str, quantity: str, coordinate: str | None, answer: str, options: tuple = ()
 ) -> dict:
-    return judge_job(spec_text, quantity, coordinate, answer, near)
+    return judge_job(spec_text, quantity, coordinate, answer, options)
+
+
+def options_of(part: dict[str, Any]) -> tuple:
+    """What an equilibrium or frequency part adds to its quantity, as a hashable tuple."""
+    return tuple((k, part[k]) for k in ("near", "mode") if part.get(k) is not None)
 
 
 def judge(variant: Variant, part: dict[str, Any], answer: str, run: Runner = _local) -> Judged:
@@ -94,7 +99,7 @@ def judge(variant: Variant, part: dict[str, Any], answer: str, run: Runner = _lo
     quantity = part["quantity"]
     try:
         verdict = run(
-            variant.spec_text(), quantity, part.get("coordinate"), answer, part.get("near")
+            variant.spec_text(), quantity, part.get("coordinate"), answer, options_of(part)
         )
     except ExprError as exc:
         code = outcomes.code(quantity, outcomes.UNREADABLE)
@@ -125,7 +130,7 @@ def key_still_holds(
             part["quantity"],
             part.get("coordinate"),
             stored_key,
-            part.get("near"),
+            options_of(part),
         )
     except (ExprError, BudgetExceeded):
         return False

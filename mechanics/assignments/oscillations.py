@@ -1,5 +1,5 @@
 """Two parts beyond the checker's quantities: an equilibrium position and a small-oscillation
-frequency, for a scene with one coordinate.
+frequency, for a scene with one coordinate (a frequency of a scene with several: normal_modes.py).
 
 - ``equilibrium``: q₀ where ∂V/∂q = 0, the root nearest the part's ``near`` value at the scene's
   parameters (the pendulum has two; the hanging spring one, m g / k).
@@ -23,6 +23,7 @@ import sympy as sp
 from mechanics.derive import Derivation
 from mechanics.expr import ExprError, parse, to_latex
 
+from . import normal_modes
 from .verify import Check, zero
 
 QUANTITIES = ("equilibrium", "frequency")
@@ -92,12 +93,16 @@ def second_route(d: Derivation, quantity: str, near: float, at: sp.Expr | None) 
 
 def key(d: Derivation, part: dict[str, Any]) -> sp.Expr:
     near = float(part.get("near") or 0.0)
+    if part["quantity"] == "frequency" and len(d.model.q) > 1:
+        return normal_modes.key(d, part)
     if part["quantity"] == "equilibrium":
         return equilibrium_key(d, near)
     return frequency_key(d, equilibrium_key(d, near))
 
 
 def verify(d: Derivation, part: dict[str, Any], engine: sp.Expr) -> Check:
+    if part["quantity"] == "frequency" and len(d.model.q) > 1:
+        return zero(engine - normal_modes.second_route(d, part), d.model)
     near = float(part.get("near") or 0.0)
     at = equilibrium_key(d, near) if part["quantity"] == "frequency" else None
     other = second_route(d, part["quantity"], near, at)

@@ -111,8 +111,11 @@ class Part(_Model):
     id: Ident
     quantity: Literal["T", "V", "L", "Q", "eom", "accel", "momentum", "equilibrium", "frequency"]
     coordinate: Ident | None = None
-    #: equilibrium / frequency: the equilibrium asked is the one nearest this value of q
+    #: equilibrium / frequency: the equilibrium asked is the one nearest this value of q (several
+    #: coordinates: every coordinate at this value)
     near: float | None = None
+    #: frequency of a scene with several coordinates: which normal mode (1: the slowest)
+    mode: int = Field(default=1, ge=1, le=3)
     weight: float = Field(default=1.0, gt=0, le=100)
     prompt: str = Field(default="", max_length=400)
     partial: dict[str, Annotated[float, Field(ge=0, le=1)]] = {}
@@ -178,11 +181,13 @@ def parse_template(data: dict[str, Any]) -> Template:
         raise SpecError([{**e, "field": f"scene_spec.{e['field']}"} for e in exc.errors]) from None
     errors = []
     for i, part in enumerate(template.parts):
-        if part.quantity in ("equilibrium", "frequency") and len(spec.coordinates) != 1:
+        limit = 1 if part.quantity == "equilibrium" else 3
+        if part.quantity in ("equilibrium", "frequency") and len(spec.coordinates) > limit:
             errors.append(
                 {
                     "field": f"parts[{i}].quantity",
-                    "message": f"{part.quantity} parts need a scene with one coordinate",
+                    "message": f"{part.quantity} parts need a scene with at most {limit} "
+                    "coordinate(s)",
                 }
             )
     for name in template.parameters:

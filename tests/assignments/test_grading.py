@@ -127,3 +127,12 @@ def test_an_equilibrium_and_a_frequency_are_graded():
     rest = one_part("physical_pendulum", "equilibrium")
     assert attempt(rest, [], "0", Policy()).judged.code == "q0.correct"
     assert attempt(rest, [], "theta", Policy()).judged.code == "q0.unreadable"
+
+
+def test_a_normal_mode_is_graded():
+    """The double pendulum with m1 = m2 = 1 and l1 = l2 = 1 given: ω₁ = √((2 − √2) g)."""
+    given = {n: {"values": [1.0], "given": True} for n in ("m1", "m2", "l1", "l2")}
+    variant = one_part("double_pendulum", "frequency", parameters=given)
+    assert attempt(variant, [], "sqrt((2-sqrt(2))*g)", Policy()).judged.code == "omega.correct"
+    fast = attempt(variant, [], "sqrt((2+sqrt(2))*g)", Policy())  # the other mode
+    assert (fast.judged.code, fast.score) == ("omega.wrong", 0.0)

@@ -117,3 +117,28 @@ def test_a_frequency_about_an_unstable_equilibrium_is_never_deployed():
     }  # θ = π: on top
     keys = variant_keys(build_variant(parse_template(document), "1"))
     assert not keys.deployable and "not stable" in keys.why_not
+
+
+def test_the_double_pendulums_normal_modes_are_the_hand_derived_ones():
+    """Equal masses and lengths: ω² = (2 ∓ √2) g / l (the textbook result), both verified."""
+    from mechanics.assignments.oscillations import key, verify
+
+    variant = one_part("double_pendulum", "frequency")
+    d = derivation(variant)
+    p = d.model.params
+    equal = {p["m2"]: p["m1"], p["l2"]: p["l1"]}
+    for mode, sign in ((1, -1), (2, +1)):
+        part = {**variant.parts[0], "mode": mode}
+        omega = key(d, part)
+        by_hand = (2 + sign * sp.sqrt(2)) * p["g"] / p["l1"]
+        values = {p["m1"]: 1.3, p["l1"]: 0.7, p["g"]: 9.81}
+        assert complex((omega**2).subs(equal).subs(values)) == pytest.approx(
+            complex(by_hand.subs(values))
+        )
+        assert verify(d, part, omega).ok
+
+
+def test_a_free_coordinate_has_no_frequency_to_ask():
+    """The cart is free to roll: one mode has ω = 0, so the variant is not deployed."""
+    keys = variant_keys(one_part("cart_pendulum", "frequency"))
+    assert not keys.deployable and "free coordinate" in keys.why_not
