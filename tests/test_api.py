@@ -288,7 +288,7 @@ def test_a_real_server_is_fast_warm_and_survives_bad_and_runaway_requests(tmp_pa
                 start = time.perf_counter()
                 assert http.post("/api/v1/derive", json=builtin).status_code == 200
                 timings.append(time.perf_counter() - start)
-            # ~1.5 ms on an idle machine (python -m mechanics.bench derive measures it); the
+            # ~1.5 ms on an idle machine (python -m benchmarks derive measures it); the
             # bound here only proves the warm path is a lookup, not a derivation (~100 ms+)
             assert statistics.median(timings) < 0.05, timings
             # a spec never derived before: a cached derivation needs no budget (it answers at once)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from mechanics.bench_integrate import TARGET_ENERGY, bench_target, print_target, speedup
+from benchmarks.integrate import TARGET_ENERGY, bench_target, print_target, speedup
 
 
 def test_speedup_compares_with_the_most_accurate_baseline_we_can_match():

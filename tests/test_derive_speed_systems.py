@@ -1,6 +1,6 @@
 """The systems a class posts together (issue 23, trust round 4, item 8): the restricted
 three-body problem in a rotating frame, written two ways, and PyDy's two-link conical pendulum.
-Their speed is the derive benchmark's (``python -m mechanics.bench derive three_body ...``);
+Their speed is the derive benchmark's (``python -m benchmarks derive three_body ...``);
 here: their equations against sympy's LagrangesMethod built in this file from first principles
 (frames, points, the potential written from the distances to the primaries) at random states,
 the potential kept as written (its f had 3,313 operations when it was put over one denominator),
@@ -25,9 +25,9 @@ from sympy.physics.mechanics import (
     msubs,
 )
 
+from benchmarks.systems import THREE_BODY, THREE_BODY_SI, conical_pendulum
 from mechanics.derive import derive_model
 from mechanics.provenance import TOO_LARGE, provenance
-from mechanics.systems_large import THREE_BODY, THREE_BODY_SI, conical_pendulum
 
 _derived: dict = {}
 

@@ -29,7 +29,7 @@ from sympy.physics.mechanics import (
     msubs,
 )
 
-from mechanics.bench import SYSTEMS
+from benchmarks.derive import SYSTEMS
 from mechanics.derive import derive_model
 
 TRIPLE_PENDULUM = SYSTEMS["triple_pendulum"]

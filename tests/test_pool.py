@@ -30,7 +30,7 @@ HOSTILE_ANSWERS = ["(theta + theta_dot + m + 1)**30", "(m+l+g+theta+theta_dot)**
 def heavy_spec() -> dict:
     """A posted six-link chain never seen before (its g is new): seconds of sympy in a worker,
     the heaviest honest-looking work a client can send."""
-    from mechanics.bench import chain_spec
+    from benchmarks.derive import chain_spec
 
     spec = chain_spec(6)
     spec["parameters"]["g"] = 9.81 + (time.time_ns() % 10**6) * 1e-9

@@ -1,4 +1,4 @@
-"""Benchmarks: ``python -m mechanics.bench derive`` (and ``integrate``, in bench_integrate.py).
+"""Benchmarks: ``python -m benchmarks derive`` (and ``integrate``, in bench_integrate.py).
 
 Side by side in one process, per built-in scene: the engine's cold derivation (every step,
 simplified), its warm answer over HTTP, and sympy's LagrangesMethod followed by simplify() of the
@@ -6,7 +6,7 @@ mass matrix and forcing on the same system — the baseline a careful student wo
 rather than absolute times, because the machine's speed drifts.
 
 Then systems larger than any built-in scene (a triple pendulum, a heavy symmetric top through
-three Euler rotations, a six-link chain, and mechanics/systems_large.py's restricted three-body
+three Euler rotations, a six-link chain, and benchmarks/systems.py's restricted three-body
 problem and conical pendulums of two and three links), each derived cold: a fresh process with an
 empty cache, the way a posted scene is first derived. Wall and CPU seconds, median of a few runs,
 and the 1-minute load average when each system started (the machine is shared: CPU seconds are
@@ -27,10 +27,10 @@ import time
 import sympy as sp
 from sympy.core.cache import clear_cache
 
+from benchmarks.systems import LARGE_SYSTEMS
 from mechanics import oracle
 from mechanics.derive import derivation_of_scene
 from mechanics.scenes import scene_ids
-from mechanics.systems_large import LARGE_SYSTEMS
 
 
 def chain_spec(n: int) -> dict:
@@ -249,7 +249,7 @@ def print_derive(rows: list[dict]) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m mechanics.bench")
+    parser = argparse.ArgumentParser(prog="python -m benchmarks")
     sub = parser.add_subparsers(dest="what", required=True)
     d = sub.add_parser(
         "derive", help="derivation cost per built-in scene vs sympy, then larger systems cold"
@@ -275,7 +275,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     if args.what == "load":
-        from mechanics.bench_load import main as load_main
+        from benchmarks.load import main as load_main
 
         if not 1 <= args.students <= 1000 or not 0 < args.duration <= 600:
             parser.error("--students must be 1..1000 and --duration 0..600 s")
@@ -293,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
             print("\n" if scenes else "", end="")
             print_systems(bench_systems(systems, max(1, min(args.runs, 9))))
     else:
-        from mechanics.bench_integrate import main as integrate_main
+        from benchmarks.integrate import main as integrate_main
 
         integrate_main(args.scenes, args.html)
     return 0

@@ -1,4 +1,4 @@
-"""``python -m mechanics.bench_page``: how fast a scene page shows its derivation and a moving
+"""``python -m benchmarks page``: how fast a scene page shows its derivation and a moving
 animation, and how many bytes it transfers, first visit and repeat (issue 13, item 1).
 
 Starts the app on a free loopback port (or measures ``--url``), warms the server (every scene's

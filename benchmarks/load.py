@@ -1,4 +1,4 @@
-"""``python -m mechanics.bench load``: a lecture hall of simulated students against a real server.
+"""``python -m benchmarks load``: a lecture hall of simulated students against a real server.
 
 The server is ``python -m app serve`` (``lagrange-lab serve``) started as a subprocess on a free
 loopback port, so this module never imports the web layer. Every student is an HTTP client with
@@ -230,7 +230,7 @@ def _edited(spec: dict, rng: random.Random) -> dict:
 
 def hostile_requests(count: int, rng: random.Random) -> list[tuple[str, str, dict]]:
     """``count`` hostile requests, the kinds in turn: (kind, path, body)."""
-    from mechanics.bench import chain_spec
+    from benchmarks.derive import chain_spec
 
     out = []
     for i in range(count):
@@ -278,7 +278,7 @@ async def probe_health(base: str, stop: float, tally: Tally) -> None:
 async def post_heavy_specs(base: str, index: int, stop: float, tally: Tally) -> None:
     """One client that posts heavy specs (a six-link chain, each new) one after another until
     ``stop``: derive, then simulate it. Its answers are tallied as "poster ..." (not honest)."""
-    from mechanics.bench import chain_spec
+    from benchmarks.derive import chain_spec
 
     rng = random.Random(1000 + index)
     transport = httpx.AsyncHTTPTransport(local_address=f"127.0.252.{index + 1}")

@@ -1,4 +1,4 @@
-"""``python -m mechanics.bench integrate``: the speed/accuracy trade, measured.
+"""``python -m benchmarks integrate``: the speed/accuracy trade, measured.
 
 For each scene a reference solution (DOP853 at rtol 1e-13) is computed first; then every method
 at several tolerances (or steps) runs on the same problem and reports wall time, RHS evaluations,
@@ -348,7 +348,7 @@ def bench_target(runs: int = 7) -> list[dict]:
                     "energy": stats["energy_error"],
                 }
             )
-    from mechanics.bench import _http_server
+    from benchmarks.derive import _http_server
 
     send = _http_server()
     body = {

@@ -1,13 +1,13 @@
-"""``python -m mechanics.bench_class``: a class that types its own answers, side by side.
+"""``python -m benchmarks class``: a class that types its own answers, side by side.
 
-The issue-24 measurement: 200 students (mechanics/bench_load.py), each sending values of its own
+The issue-24 measurement: 200 students (benchmarks/load.py), each sending values of its own
 (parameters, initial state, answers to check), 2 s think time, with and without clients posting
 heavy specs all along, and /simulate run with two methods side by side: the API's default (what a
 REST client gets by sending no method) and ``DOP853``, the default before (scipy's stepper in
 Python). Each configuration gets a fresh server and an empty cache; the machine's load average is
 printed with each, since on a shared machine it moves every number.
 
-    python -m mechanics.bench_class --students 200 --think 2 --duration 60 --posters 0 4
+    python -m benchmarks class --students 200 --think 2 --duration 60 --posters 0 4
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import argparse
 import collections
 import sys
 
-from mechanics.bench_load import TARGETS_MS, percentile, print_config, run_config
+from benchmarks.load import TARGETS_MS, percentile, print_config, run_config
 
 ROUTES = (*TARGETS_MS, "healthz")
 
@@ -52,7 +52,7 @@ def side_by_side(results: list[dict]) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m mechanics.bench_class", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m benchmarks class", description=__doc__)
     parser.add_argument("--students", type=int, default=200)
     parser.add_argument("--think", type=float, default=2.0)
     parser.add_argument("--duration", type=float, default=60.0)
