@@ -201,7 +201,8 @@ class SimulateRequest(DeriveRequest):
     method: MethodName = Field(  # type: ignore[valid-type]
         default="dop853_c",
         description="Default dop853_c: DOP853's steps in C (scipy's DOP853 where C cannot run; "
-        "stats.method names the one that ran). euler, symplectic_euler, rk4, implicit_midpoint (fixed step: give dt), or "
+        "stats.method names the one that ran). euler, symplectic_euler, rk4, implicit_midpoint "
+        "(fixed step: give dt), or "
         "RK45, DOP853, dop853_c, dop853_fortran, Radau, BDF, LSODA (adaptive: rtol, atol); "
         "`GET /api/v1/methods` lists each with its order and properties.",
     )

@@ -63,6 +63,16 @@ class Settings:
     #: "0" switches off making every built-in scene ready when the server starts (derivation,
     #: compiled equations, equilibria; in the background): the first request then pays for it.
     warm: bool = True
+    #: SQLAlchemy URL of the assignments' database (several app servers share it, e.g.
+    #: postgresql+psycopg://user@host/db); empty: a SQLite file in ``data_dir``
+    #: (read by app/assignments/db.py).
+    database_url: str = ""
+    #: Folder of the assignments' SQLite file when no ``database_url`` is given
+    #: (read by app/assignments/db.py).
+    data_dir: Path = Path.home() / ".local" / "share" / "lagrange-lab"
+    #: Submissions one student may make per minute, over every assignment (counted in the
+    #: database; read by app/assignments/service.py).
+    submissions_per_minute: int = 30
 
     @classmethod
     def from_env(cls, environ: Mapping[str, str] | None = None) -> Settings:

@@ -101,7 +101,7 @@ log = logging.getLogger(__name__)
 
 #: Bump when the output of any store changes (a derivation step, equilibria, the generated C...),
 #: so entries of the old engine are never served. Part of every key and every entry.
-ENGINE_VERSION = "17"
+ENGINE_VERSION = "18"
 
 ENV_VAR = "LAGRANGE_LAB_CACHE"
 REDIS_ENV_VAR = "LAGRANGE_LAB_REDIS_URL"
