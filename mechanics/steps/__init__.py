@@ -153,7 +153,7 @@ def _tidy_symbols(expr: sp.Expr, velocities: tuple, factor_whole: bool = True) -
     """tidy() on plain symbols. Cached across derivations, so it returns the pieces it left
     unsimplified instead of reporting them: a cache hit must flag exactly what a miss flags."""
     roots = radicals(expr)
-    if roots:  # roots or quotients of sums: see steps/radicals.py
+    if roots:  # roots of sums (not 1/(a + b)): see steps/radicals.py
         return tidy_radical(expr, roots, velocities, _trig_pass, _size, factor_whole)
     e = sp.expand(expr)
     if e == 0:

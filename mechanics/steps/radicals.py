@@ -1,16 +1,21 @@
-"""The textbook form of a piece with roots or quotients of sums in it (a gravitational potential
+"""The textbook form of a piece with roots of sums in it (a gravitational potential
 −G M m/√((x − a)² + y²), a spring's length √(x² + y²)): why a separate pass.
 
-tidy()'s trig pass is made for polynomials in q, q̇ and sin/cos of the angles. Handed a quotient
-or a root of a sum it expands the sum under the root, puts everything over one denominator
-(factor) and differentiates that quotient in the next step: the restricted three-body problem's
-f grew from 140 to 3,300 operations and took seconds per piece. Here each root or inverse power of
-a sum is held as one symbol while the rest is expanded, grouped by velocity monomial and by that
-symbol, and each group's polynomial coefficient gets the ordinary trig pass: the terms of the
-potential stay as they were written, one per attracting body.
+tidy()'s trig pass is made for polynomials in q, q̇ and sin/cos of the angles. Handed a root of a
+sum it expands the sum under the root, puts everything over one denominator (factor) and
+differentiates that quotient in the next step: the restricted three-body problem's f grew from
+140 to 3,300 operations and took seconds per piece. Here each root of a sum (a power with a
+fractional exponent: −1/2, −3/2, 1/2) is held as one symbol while the rest is expanded, grouped by
+velocity monomial and by that symbol, and each group's polynomial coefficient gets the ordinary
+trig pass: the terms of the potential stay as they were written, one per attracting body.
 
-No built-in scene has such a piece (every one of their pieces is a trig polynomial), so their
-derivations are unchanged by it.
+An integer inverse power of a sum, 1/(m₁ + m₂) or 1/(M + m sin²θ), is NOT held: putting it over
+one denominator with the rest is the simplification the reader wants. Held, the Atwood rope's
+force stayed g m₁ ((m₂ − m₁)/(m₁ + m₂) + 1) instead of 2 g m₁ m₂/(m₁ + m₂), and the ladder's
+contact geometry kept 1/(sin²θ + cos²θ), so its two normal forces were not found.
+
+No built-in scene has a root of a sum in any piece it tidies (derivation or Newton's panel), so
+their output is unchanged by this pass.
 """
 
 from __future__ import annotations
@@ -21,12 +26,13 @@ import sympy as sp
 
 
 def radicals(expr: sp.Expr) -> list[sp.Pow]:
-    """The powers of a sum with a fractional or negative exponent, outermost only, in a fixed
-    order (the symbols standing for them must not depend on hashing)."""
+    """The powers of a sum with a non-integer exponent (roots), outermost only, in a fixed order
+    (the symbols standing for them must not depend on hashing). Integer inverse powers are left
+    to the ordinary pass, which cancels them (see the module docstring)."""
     found: set[sp.Pow] = set()
 
     def walk(e: sp.Expr) -> None:
-        if e.is_Pow and e.base.is_Add and not (e.exp.is_Integer and e.exp >= 0):
+        if e.is_Pow and e.base.is_Add and not e.exp.is_integer:
             found.add(e)
             return
         for a in e.args:
