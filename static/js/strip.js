@@ -44,7 +44,8 @@ export class LectureStrip {
       item.className = "strip-param";
       const label = Object.assign(document.createElement("label"), { htmlFor: `strip-n-${name}`, title: name });
       label.textContent = nameText(name);
-      const unit = row.querySelector(".unit")?.textContent;
+      // m/s^2 as m/s², N*s/m as N·s/m: read from the back of the room
+      const unit = row.querySelector(".unit")?.textContent.replace(/\^2/g, "²").replace(/\^3/g, "³").replace(/\*/g, "·");
       if (unit) label.append(Object.assign(document.createElement("span"), { className: "unit", textContent: ` ${unit}` }));
       const s = Object.assign(document.createElement("input"), { type: "range", id: `strip-s-${name}` });
       Object.assign(s, { min: slider.min, max: slider.max, step: slider.step, value: slider.value });
