@@ -2,9 +2,10 @@
 
 A lecture hall opens the same scene at the same moment: 200 identical `/simulate` requests for a
 built-in scene at its default parameters. The run is deterministic (the same request gives the
-same trajectory, tests/test_determinism.py), so the first one computes and the others wait for it
-(single flight) or find it done; a slider moved to a value someone else already tried is served
-the same way. Only encoded answers are kept, bounded by count and by bytes, in this process.
+same trajectory, tests/derivation/test_determinism.py), so the first one computes and the others
+wait for it (single flight) or find it done; a slider moved to a value someone else already
+tried is served the same way. Only encoded answers are kept, bounded by count and by bytes, in
+this process.
 
 What is kept is exactly what the first request was answered: its stats still say what that run
 cost (steps, evaluations, wall time), which is what it costs to compute.

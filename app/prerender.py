@@ -7,7 +7,7 @@ pages then put those equations up as they are (static/js/prerendered.js). Each f
 by its exact TeX and the font size it was typeset at (MathJax's smallest script size is in
 pixels, so a subscript of a subscript is drawn a little differently at 16 px and at lecture
 mode's 24 px), so a file older than the derivation only misses (that formula is typeset live);
-``tests/test_prerendered_files.py`` fails when a file no longer covers its derivation, and
+``tests/pages/test_prerendered_files.py`` fails when a file no longer covers its derivation, and
 ``tests/browser/test_prerendered_math.py`` when a formula renders differently live.
 
 The pages are read at the sizes the room uses (a laptop, lecture mode on three projectors, a

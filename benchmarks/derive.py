@@ -79,7 +79,7 @@ HEAVY_TOP = {
 }
 
 #: Systems past the built-in catalog, derived cold by `bench_systems` (and checked against
-#: LagrangesMethod in tests/test_determinism.py).
+#: LagrangesMethod in tests/derivation/test_determinism.py).
 SYSTEMS = {
     "triple_pendulum": chain_spec(3),
     "heavy_top": HEAVY_TOP,

@@ -1,8 +1,8 @@
 """Posted systems past the built-in catalog that a class sends together (issue 23, item 8): the
 restricted three-body problem in a rotating frame, written two ways, and PyDy's conical pendulum
 of two and three rigid links with bobs. The derive benchmark (``python -m benchmarks derive
-three_body ...``) times them cold; tests/test_derive_speed_systems.py checks their equations
-against sympy's LagrangesMethod built from first principles.
+three_body ...``) times them cold; tests/derivation/test_derive_speed_systems.py checks their
+equations against sympy's LagrangesMethod built from first principles.
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ page learns the names, in slot order, from the JSON beside it (`live_names`).
 The module exports::
 
     dims = {n, extras, params, points, frames}
-    rhs(t, y, p, dy)       // dy/dt for y = [q, q̇, W_NC (, W_t)]; returns 0, or 2 when M is singular
+    rhs(t, y, p, dy)       // dy/dt for y = [q, q̇, W_NC (, W_t)]; 0, or 2 where M is singular
     places(t, y, p, out)   // out[3k..3k+2] = x, y, z of point k (bodies and named points)
     axes(t, y, p, out)     // out[9f..9f+8] = the 3 axes of frame f in N (rows, as the server's)
     energy(t, y, p, out)   // out[0] = T, out[1] = V

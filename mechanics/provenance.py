@@ -18,9 +18,10 @@ monomial (q̈_k, q̇_k q̇_l, …: what tidy() groups by); where one monomial ho
 pieces with different q-dependence they stay separate when every origin splits cleanly between
 them. Each origin's contribution to a term is its coefficient of that monomial, so by linearity
 the contributions of a term add up to it exactly and the terms add up to the displayed equation
-exactly (tests/test_provenance.py checks both on every built-in scene). In an equation of motion
-each origin enters through one of the Euler–Lagrange pieces: d/dt ∂T/∂q̇_j, −∂T/∂q_j, +∂V/∂q_j
-(left side) or Q_j (right side); contributions of a monomial that cancel are listed too.
+exactly (tests/derivation/test_provenance.py checks both on every built-in scene). In an
+equation of motion each origin enters through one of the Euler–Lagrange pieces: d/dt ∂T/∂q̇_j,
+−∂T/∂q_j, +∂V/∂q_j (left side) or Q_j (right side); contributions of a monomial that cancel
+are listed too.
 
 Term ids are a hash of the term's canonical form, so the same term has the same id in every
 equation where it appears and a page can light it up everywhere at once.

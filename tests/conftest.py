@@ -30,7 +30,7 @@ def pytest_configure(config: pytest.Config) -> None:
         os.environ[_SESSION_CACHE] = folder
         _owned.append(folder)
     # The servers tests start do not warm every scene in the background (2 cores: it would slow
-    # every other test); tests/test_warm_up.py switches it on where it is the subject.
+    # every other test); tests/serving/test_warm_up.py switches it on where it is the subject.
     os.environ.setdefault("LAGRANGE_LAB_WARM", "0")
 
 
@@ -49,22 +49,23 @@ def pytest_unconfigure(config: pytest.Config) -> None:
 #: the other one stopped. Named by node id (prefix), so the scheduler in the controller, which
 #: collects nothing, knows them too.
 SERIAL = (
-    "tests/test_simulate_fairness.py::test_a_flood_from_one_client_neither_fails_nor_delays",
-    "tests/test_budget.py::test_runaway_work_is_stopped_at_the_time_budget",
-    "tests/test_budget.py::test_one_clients_queue_does_not_delay_another_client",
-    "tests/test_pool.py::test_one_clients_heavy_requests_do_not_delay_another_client",
-    "tests/test_pool.py::test_hostile_answers_are_refused_within_the_budget",
-    "tests/test_fixed_step.py::test_a_finite_time_blow_up_is_told_as_one",
-    "tests/test_api.py::test_a_100_kb_expression_is_refused_fast",
-    "tests/test_integrators.py::test_stiff_linear_problem_is_solved_quickly",
-    "tests/test_check_trust.py::test_an_undecidable_hostile_answer_is_refused_a_proof_quickly",
+    "tests/api/test_simulate_fairness.py::test_a_flood_from_one_client_neither_fails_nor_delays",
+    "tests/serving/test_budget.py::test_runaway_work_is_stopped_at_the_time_budget",
+    "tests/serving/test_budget.py::test_one_clients_queue_does_not_delay_another_client",
+    "tests/serving/test_pool.py::test_one_clients_heavy_requests_do_not_delay_another_client",
+    "tests/serving/test_pool.py::test_hostile_answers_are_refused_within_the_budget",
+    "tests/numerics/test_fixed_step.py::test_a_finite_time_blow_up_is_told_as_one",
+    "tests/api/test_api.py::test_a_100_kb_expression_is_refused_fast",
+    "tests/numerics/test_integrators.py::test_stiff_linear_problem_is_solved_quickly",
+    "tests/answers/test_check_trust.py::"
+    "test_an_undecidable_hostile_answer_is_refused_a_proof_quickly",
     "tests/browser/test_live.py::test_a_drag_keeps_sixty_frames_a_second",
     "tests/browser/test_live.py::test_a_slider_input_is_drawn_within_a_few_frames",
     "tests/browser/test_drag3d.py::test_a_3d_drag_keeps_sixty_frames_a_second",
     # the installed server's runs wait at most a few seconds for their turn, then answer 503 (its
     # browser test saw four 503s beside a browser worker, load 13-20); the whole module, so its
     # wheel and venv are built once
-    "tests/test_install.py::",
+    "tests/install/test_install.py::",
 )
 
 

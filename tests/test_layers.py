@@ -120,13 +120,13 @@ ALLOWED_UNEXPLAINED: set[str] = {
 }
 #: Test files still named after a review round.
 ALLOWED_ROUND_NAMES: set[str] = {
-    "tests/test_check_feedback4.py",
-    "tests/test_check_feedback5.py",
-    "tests/test_check_trust.py",
-    "tests/test_equilibria_text3.py",
-    "tests/test_equilibria_trust.py",
-    "tests/test_equilibria_trust5.py",
-    "tests/test_share_trust.py",
+    "tests/answers/test_check_feedback4.py",
+    "tests/answers/test_check_feedback5.py",
+    "tests/answers/test_check_trust.py",
+    "tests/equilibria/test_equilibria_text3.py",
+    "tests/equilibria/test_equilibria_trust.py",
+    "tests/equilibria/test_equilibria_trust5.py",
+    "tests/export/test_share_trust.py",
 }
 # fmt: on
 

@@ -1,7 +1,7 @@
 """A real PostgreSQL for the store's tests: Debian's server binaries, a cluster made by initdb in
-a temporary folder, started by pg_ctl on a free loopback port (as tests/servers.py starts Redis),
-stopped and removed afterwards. Run as the ``postgres`` user when the tests run as root (initdb
-refuses root)."""
+a temporary folder, started by pg_ctl on a free loopback port (as tests/support/servers.py starts
+Redis), stopped and removed afterwards. Run as the ``postgres`` user when the tests run as root
+(initdb refuses root)."""
 
 from __future__ import annotations
 

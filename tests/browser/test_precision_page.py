@@ -83,7 +83,8 @@ def test_run_shows_fitted_orders_near_the_textbook_orders(panel_page):
         "#precision .methods input:checked", "boxes => boxes.map(b => b.value)"
     )
     assert checked == ["euler", "rk4", "DOP853"]
-    # RK4 in its asymptotic range on this swing, DOP853 over 1e-5 … 1e-10 (tests/test_precision.py)
+    # RK4 in its asymptotic range on this swing, DOP853 over 1e-5 … 1e-10
+    # (tests/simulation/test_precision.py)
     page.fill("#precision-step-from", "0.0125")
     page.fill("#precision-step-to", "0.0015625")
     page.fill("#precision-tol-from", "1e-5")
