@@ -158,16 +158,22 @@ def one_line(text: str) -> str:
 #: What makes a spreadsheet (Excel, LibreOffice, Google Sheets) read a cell as a formula: a title
 #: or a stop message is someone's text, and ``x,=HYPERLINK("http://…")`` in it would be a cell
 #: that runs when the CSV is opened (OWASP "CSV injection").
-FORMULA_START = frozenset("=+-@\t\r")
+#: What starts a formula, fullwidth forms included (a spreadsheet may fold them to ASCII).
+FORMULA_START = frozenset("=+-@\t\r＝＋－＠")
+#: What a spreadsheet may split a line's cells at: a comma, or a semicolon (the separator of most
+#: European locales, and one LibreOffice guesses). A tab starts a formula instead (OWASP), so a
+#: cell after a tab is defused as one.
+_CELL_BREAK = re.compile(r"([,;])")
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|nan)", re.IGNORECASE)
 
 
 def defused(text: str) -> str:
-    """``text`` with each of its comma-separated cells that a spreadsheet would run as a formula
-    prefixed with ``'`` (the spreadsheets' own mark for "this is text"); a number such as -1.5
-    is left as it is, and so is every other cell. A cell's leading spaces and opening quote are
-    looked through: ``"=1+1"`` is the cell =1+1 to a CSV reader."""
-    return ",".join(_defused_cell(cell) for cell in text.split(","))
+    """``text`` with each of its cells that a spreadsheet would run as a formula prefixed with
+    ``'`` (the spreadsheets' own mark for "this is text"); a number such as -1.5 is left as it is,
+    and so is every other cell. Cells are cut at every separator a spreadsheet may use (comma or
+    semicolon), since the reader's locale picks it. A cell's leading spaces and opening quote
+    are looked through: ``"=1+1"`` is the cell =1+1 to a CSV reader."""
+    return "".join(_defused_cell(part) for part in _CELL_BREAK.split(text))
 
 
 def _defused_cell(cell: str) -> str:

@@ -56,6 +56,16 @@ def test_numbers_stay_numbers():
     assert defused("a,\tb") == "a,'\tb"
 
 
+def test_a_semicolon_or_a_fullwidth_sign_does_not_hide_a_formula():
+    """Hostile play-test (2026-12-02): a title 'semi;=HYPERLINK(...)' passed as one comma cell,
+    but Excel in most European locales and LibreOffice's guess split at ';', and '＝' is folded
+    to '=' by some spreadsheets (OWASP)."""
+    assert defused('semi;=HYPERLINK("http://e.vil")') == 'semi;\'=HYPERLINK("http://e.vil")'
+    assert defused("msg;@SUM(1+1)") == "msg;'@SUM(1+1)"
+    assert defused("＝1+1") == "'＝1+1"
+    assert defused("a; -1.5; 2") == "a; -1.5; 2"
+
+
 def test_the_data_rows_keep_negative_numbers():
     r = client.get("/api/v1/export/scenes/spring_mass_damper/trajectory.csv?t_end=1")
     rows = [row for row in csv.reader(io.StringIO(r.text)) if row and not row[0].startswith("#")]
