@@ -25,7 +25,11 @@ from sympy.physics.vector import Vector
 
 from mechanics.derive import Derivation
 from mechanics.expr import to_latex, to_plain
-from mechanics.newton_potentials import potential_virtual_work, unknown_constraint_forces
+from mechanics.newton_potentials import (
+    potential_forces,
+    potential_virtual_work,
+    unknown_constraint_forces,
+)
 from mechanics.steps import Line, Step, sub, tidy, vec_in, vec_line
 from mechanics.steps.fbd import body_forces, constraint_forces, resultant_name, rod_anchor
 
@@ -58,11 +62,13 @@ def newton(d: Derivation) -> tuple[list[Step], list[ConstraintForce], list[sp.Ex
     residual = [sp.S.Zero] * len(m.q)  # Σ_i (m a_i − F_i)·∂r_i/∂q_j, torques included
     # a potential V(q) fixes only its force's virtual work, not the force (newton_potentials)
     unknown = unknown_constraint_forces(m)
+    pushes = potential_forces(m) or {}  # −∇V on free particles: then in ΣF, not added apart
     for j, dV in enumerate(potential_virtual_work(m)):
-        residual[j] += dV
+        residual[j] += 0 if pushes else dV
     for b in m.bodies:
         a = m.velocity(b.name).dt(m.N)
         applied = sum((vec for _, kind, vec in acting[b.name] if kind != "torque"), Vector(0))
+        applied += pushes.get(b.name, Vector(0))
         frame = b.natural_frame
         balance_lines.append(
             vec_line(rf"m\vec{{a}}_{{{sub(b.name)}}}", b.mass * a, frame, m, f"m a of {b.name}")
@@ -167,7 +173,13 @@ def _steps(
         r"$\vec F_C$ named as in the free-body diagram (the rope's or rod's $\vec F_T$, a "
         r"normal force $\vec F_N$) when it is one force there."
     )
-    if m.potentials:
+    if m.potentials and unknown is None and potential_forces(m):
+        text += (
+            " No constraint acts on any body here (the map from the coordinates to the positions "
+            r"is invertible), so the scene's potentials fix their force in space, "
+            r"$\vec F = -\nabla V$, and it is in $\sum \vec F$."
+        )
+    elif m.potentials:
         text += (
             " The scene's potentials are not forces on any one body: they enter the balances "
             r"projected on each $\delta q_j$, as $-\partial V/\partial q_j$, and are not in "

@@ -8,6 +8,12 @@ constraints, V(q) cannot say: a zero-length spring pulling a bead on a ring towa
 presses the bead into the ring, and written as V(θ) that pressing is gone (0 N where the `spring`
 gives 7.3 N). So where a potential depends on the coordinates no constraint force is given, and
 the reason is said instead, in /newton, in the free-body diagram and in a run's warnings.
+
+Where no constraint acts (every body a particle whose position map q → r has an invertible
+Jacobian: a free particle in x, y, z, or in spherical coordinates) V(q) does fix the force in
+space, F = −J⁻ᵀ ∂V/∂q, and the constraint force is zero: it is computed, not refused (issue 25:
+a free particle in a bowl V = k|r|²/2 was refused with "a pull that presses a bead into its
+ring", though nothing constrains it).
 """
 
 from __future__ import annotations
@@ -15,6 +21,7 @@ from __future__ import annotations
 from typing import Any
 
 import sympy as sp
+from sympy.physics.vector import Vector
 
 from mechanics.steps import tidy
 
@@ -35,7 +42,7 @@ def unknown_constraint_forces(model: Any, *, plain: bool = False) -> str | None:
     Newton step and the free-body diagram carry its math as LaTeX between $…$ (as every step's
     prose does); a run's warnings, shown as text, take it ``plain``."""
     names = coordinate_potentials(model)
-    if not names:
+    if not names or potential_forces(model) is not None:
         return None
     which = ", ".join(f"'{n}'" for n in names)
     its = "potential" if len(names) == 1 else "potentials"
@@ -65,3 +72,29 @@ def potential_virtual_work(model: Any) -> list[sp.Expr]:
     projected on δq_j (the only part of their force V(q) fixes)."""
     V = sum((e for _, e in model.potentials), sp.S.Zero)
     return [V.diff(q) for q in model.q]
+
+
+def potential_forces(model: Any) -> dict[str, Vector] | None:
+    """−∇V on each body where V(q) fixes it: every body a particle and the stacked Jacobian
+    ∂(r₁ … r_N)/∂q square with a determinant that is not identically 0 (no constraint on any
+    body), so F = −J⁻ᵀ ∂V/∂q. None where a constraint exists (a bead on a ring: J is 3×1 and
+    V(θ) says nothing of the push into the ring) or a body is rigid (V says nothing of a torque
+    about which point)."""
+    bodies = model.bodies
+    if not bodies or any(getattr(b, "frame", None) is not None for b in bodies):
+        return None
+    if len(model.q) != 3 * len(bodies):
+        return None
+    rows = [c for b in bodies for c in b.position.to_matrix(model.N)]
+    J = sp.Matrix([[c.diff(q) for q in model.q] for c in rows])
+    det = tidy(J.det(), model)
+    if det == 0 or sp.simplify(det) == 0:
+        return None
+    grad = sp.Matrix(potential_virtual_work(model))
+    force = J.T.LUsolve(-grad)
+    axes = (model.N.x, model.N.y, model.N.z)
+    out = {}
+    for i, b in enumerate(bodies):
+        parts = (tidy(force[3 * i + k], model) * u for k, u in enumerate(axes))
+        out[b.name] = sum(parts, Vector(0))
+    return out

@@ -220,3 +220,60 @@ def test_the_planet_in_a_plane_is_not_told_nothing_pushes_across_it():
     planet = next(n for n in notes if n.startswith("planet"))
     assert "so that constraint's force is zero" not in planet
     assert "cannot say" in planet
+
+
+#: A particle free in space in a bowl V = ½ k |r|² (issue 25, item 4): nothing constrains it.
+FREE = {
+    "title": "Free particle in a bowl",
+    "coordinates": ["x", "y", "z"],
+    "parameters": {"m": 1.0, "k": 3.0},
+    "bodies": [{"name": "p", "mass": "m", "position": ["x", "y", "z"]}],
+    "potentials": [{"name": "bowl", "expression": "k*(x**2 + y**2 + z**2)/2"}],
+}
+#: The same particle in spherical coordinates: ∂r/∂(r, θ, φ) is invertible off the axis.
+SPHERICAL = {
+    **FREE,
+    "title": "Free particle in a bowl, spherical coordinates",
+    "coordinates": ["r", "th", "ph"],
+    "bodies": [
+        {
+            "name": "p",
+            "mass": "m",
+            "position": ["r*sin(th)*cos(ph)", "r*sin(th)*sin(ph)", "r*cos(th)"],
+        }
+    ],
+    "potentials": [{"name": "bowl", "expression": "k*r**2/2"}],
+}
+
+
+@pytest.mark.parametrize("spec", [FREE, SPHERICAL], ids=["cartesian", "spherical"])
+def test_a_free_particle_with_a_potential_has_zero_constraint_force(spec):
+    """By hand: with no constraint, m a = −∇V = −k r exactly (the equations of motion say so),
+    so R = m a − ΣF = 0 in every direction; the old answer refused it ('a bead pressed into
+    its ring'), though the Jacobian ∂r/∂q is invertible and −∇V is known in space."""
+    d = derivation_of_spec(spec_text(spec))
+    steps, (p,), _ = newton(d)
+    N = d.model.N
+    assert [sp.simplify(p.vector.dot(u)) for u in (N.x, N.y, N.z)] == [0, 0, 0]
+    assert "not computed" not in steps[1].to_json()["text"]
+    body = client.post("/api/v1/newton", json={"scene": spec}).json()
+    assert body["constraint_forces_unknown"] is None
+    assert body["agrees_with_lagrange"]
+    names = {n: v for n, v in zip(spec["coordinates"], (0.7, 1.1, -0.4), strict=True)}
+    names |= {f"{n}_dot": v for n, v in zip(spec["coordinates"], (0.3, -0.8, 1.9), strict=True)}
+    names |= {"m": 1.0, "k": 3.0}
+    for c in body["constraint_forces"][0]["components"]:
+        assert float(sp.sympify(c).subs(names)) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_free_particles_applied_force_is_minus_the_gradient():
+    """ΣF on the free particle is −∇V = (−k x, −k y, −k z), read off the balance line."""
+    d = derivation_of_spec(spec_text(FREE))
+    steps, _, residual = newton(d)
+    m = d.model
+    x, y, z = m.q
+    k, mass = m.params["k"], m.params["m"]
+    expected = [mass * qdd + k * q for q, qdd in zip(m.q, m.qdd, strict=True)]
+    assert [sp.simplify(r - e) for r, e in zip(residual, expected, strict=True)] == [0, 0, 0]
+    applied = next(ln for ln in steps[0].lines if "applied forces on p" in str(ln))
+    assert "k" in applied.plain and "x" in applied.plain and (x, y, z)
