@@ -70,6 +70,19 @@ def _power_words(order: int) -> str:
     return f" like $|s|^{{{order}}}$" if order else ""
 
 
+def conserved(potential: str) -> str:
+    """The conserved quantity that bounds the motion by the ``potential`` named: E = T + V for
+    a plain potential; in a steadily driven scene (a hoop spun at Ω, a support moved at v) E is
+    not conserved (the drive does work) but the Jacobi integral h = T₂ + V − T₀ is, and it is
+    what the effective potential V − T₀ stands in (issue 25, item 5)."""
+    if potential.startswith("effective"):
+        return (
+            "the Jacobi integral $h = T_2 + V - T_0$, conserved in the steadily driven scene "
+            "where $E = T + V$ is not,"
+        )
+    return "$E = T + V$"
+
+
 def amend(
     kind: str,
     reason: str,
@@ -104,7 +117,8 @@ def amend(
         return "stable", (
             flat + f"finds the force along it restoring on both sides: the {potential} rises"
             f"{_power_words(f.order)}, a strict minimum, so the equilibrium is stable "
-            "(Lagrange–Dirichlet: E = T + V cannot carry the motion over the rise). Along that "
+            f"(Lagrange–Dirichlet: {conserved(potential)} cannot carry the motion over the "
+            "rise). Along that "
             "direction the oscillation is not harmonic (its period depends on the amplitude), "
             f"which the zero eigenvalues of the linearization stand for (the motion's "
             f"eigenvalues {shown})"

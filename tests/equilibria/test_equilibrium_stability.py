@@ -259,3 +259,16 @@ def test_just_above_the_critical_spin_the_bottom_is_unstable():
     out = equilibria(derive_model(hoop(1.01 * 9.81)))
     consistent(out)
     assert at(out, theta=0.0)["kind"] == "unstable"
+
+
+def test_at_the_critical_spin_the_conserved_quantity_is_the_jacobi_integral_not_the_energy():
+    """Issue 25, item 5: the hoop is driven at Ω, which does work, so E = T + V is not
+    conserved; L has no explicit t in θ, so the Jacobi integral h = T₂ + V − T₀
+    (T₂ = ½ m R² θ̇², T₀ = ½ m R² Ω² sin² θ) is, and it is h that V_eff = V − T₀ bounds. A fixed
+    mass across two springs has no drive: there E = T + V is the right word."""
+    e = at(equilibria(derive_model(hoop(9.81))), theta=0.0)
+    assert "Jacobi integral" in e["reason"] and "h = T_2 + V - T_0" in e["reason"]
+    assert "E = T + V cannot" not in e["reason"]
+    assert "E = T + V$ is not" in e["reason"]
+    plain = at(equilibria(derive_model(across_two_springs("d"))), y=0.0)
+    assert "$E = T + V$ cannot carry" in plain["reason"] and "Jacobi" not in plain["reason"]
