@@ -209,6 +209,7 @@ def student_view(store: Store, assignment_id: str, student: str) -> dict[str, An
         policy = _policy(row.template, part)
         scores[part["id"]] = grading.part_score(attempts)
         last = done[part["id"]][-1] if done[part["id"]] else None
+        closed = part_closed(row.template, row.closed, attempts, policy)
         parts.append(
             {
                 "id": part["id"],
@@ -220,7 +221,7 @@ def student_view(store: Store, assignment_id: str, student: str) -> dict[str, An
                 "attempts_left": grading.attempts_left(attempts, policy),
                 "solved": any(a.counted and a.raw == 1.0 for a in attempts),
                 "score": scores[part["id"]],
-                "last": None if last is None else _submission_json(last),
+                "last": None if last is None else _submission_json(last, closed),
             }
         )
     return {
@@ -237,7 +238,37 @@ def student_view(store: Store, assignment_id: str, student: str) -> dict[str, An
     }
 
 
-def _submission_json(row: Any) -> dict[str, Any]:
+def part_closed(template: dict[str, Any], closed: bool, attempts: list, policy: Policy) -> bool:
+    """Whether a student may see the checker's full feedback on a part: in practice mode always;
+    in graded mode once the part is closed (answered right, out of attempts, or the assignment
+    closed). While it is open the feedback would give the key away ("Missing term 5 l² θ̇²/4"
+    is the key itself), and a retry would then be free."""
+    if template.get("mode", "graded") == "practice" or closed:
+        return True
+    if any(a.counted and a.raw == 1.0 for a in attempts):
+        return True
+    return grading.attempts_left(attempts, policy) == 0
+
+
+def student_feedback(code: str, feedback: list[str]) -> list[str]:
+    """What a student of an open graded part is told: the outcome code's parameter-free
+    description (mechanics/assignments/outcomes.py), and none of the checker's math. Kept: a
+    parse error (it is about the student's own text; the parser never sees the key) and the
+    "Cannot decide, because ..." lines this module and grading.py write (no expression)."""
+    kind = code.split(".", 1)[-1]
+    if kind == outcomes.UNREADABLE:
+        return list(feedback)
+    lines = [outcomes.meaning(code).capitalize() + "."] if code else []
+    lines += [f for f in feedback if f.startswith("Cannot decide, because")]
+    if kind not in outcomes.CREDIT:
+        lines.append("The checker's full feedback is shown once this part is closed.")
+    return lines
+
+
+def _submission_json(row: Any, full: bool = True) -> dict[str, Any]:
+    feedback = list(row.feedback or [])
+    if not full:
+        feedback = student_feedback(row.code or "", feedback)
     return {
         "submission_id": row.id,
         "part": row.part,
@@ -248,7 +279,7 @@ def _submission_json(row: Any) -> dict[str, Any]:
         "counted": row.counted,
         "attempt": row.number,
         "score": row.score,
-        "feedback": row.feedback or [],
+        "feedback": feedback,
         "answer_latex": row.answer_latex or "",
     }
 
@@ -284,9 +315,21 @@ def submit(
     if recent >= limit:
         raise Refused(429, "answer", f"more than {limit} submissions in a minute; wait a little")
     stored, new = store.store_pending(assignment_id, student, part_id, answer, request_id)
-    if not new and stored.status == "graded":
-        return _submission_json(stored)
-    return _submission_json(_grade(store, stored, chosen, part, policy, previous, run))
+    if not new and (stored.assignment_id, stored.part, stored.answer) != (
+        assignment_id,
+        part_id,
+        answer,
+    ):
+        raise Refused(
+            409,
+            "request_id",
+            f"request_id '{request_id}' was already used for another submission "
+            f"(part '{stored.part}' of assignment '{stored.assignment_id}'); send a new one",
+        )
+    if new or stored.status != "graded":
+        stored = _grade(store, stored, chosen, part, policy, previous, run)
+    attempts = [attempt_of(s) for s in store.attempts(assignment_id, student, part_id)]
+    return _submission_json(stored, part_closed(row.template, row.closed, attempts, policy))
 
 
 #: Verdicts already reached, by (scene, quantity, coordinate, answer): a class types the same
@@ -353,6 +396,10 @@ def _grade(store, stored, chosen, part, policy, previous, run) -> Any:  # noqa: 
         try:
             attempt = grading.record(previous, stored.answer, judged, policy)
         except AttemptsExhausted:
+            attempt = grading.Attempt(stored.answer, judged, False, None, None, None)
+        if attempt.counted and any(p.number == attempt.number for p in previous):
+            # the same answer again: the earlier attempt stands, this row uses none (storing its
+            # number twice broke the one-row-per-attempt index: a 409 after every renumbering)
             attempt = grading.Attempt(stored.answer, judged, False, None, None, None)
         try:
             return store.finish(stored.id, attempt)

@@ -173,6 +173,17 @@ def outcome(quantity: str, correct: bool, feedback: list[str]) -> tuple[str, lis
     return code(quantity, kinds[0]), [code(quantity, k) for k in kinds]
 
 
+def meaning(code_: str) -> str:
+    """The parameter-free description of an outcome code (``T.missing_term``: "a term is
+    missing"): what a student of an open graded part is told, since it holds no expression of
+    the key (the checker's own feedback names the missing term, i.e. gives the key away)."""
+    kind = code_.split(".", 1)[-1]
+    if kind in EXTRA_KINDS:
+        return EXTRA_KINDS[kind]
+    row = next((k for k in KINDS if k.name == kind), None)
+    return row.meaning if row is not None else "not equal to the key"
+
+
 def table() -> list[dict[str, str]]:
     """The documented table: kind, meaning, whether it scores the part in full."""
     rows = [{"kind": k.name, "meaning": k.meaning, "full_credit": k.credit} for k in KINDS]
