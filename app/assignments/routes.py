@@ -3,8 +3,9 @@ submit a part, scores and the class report, for pages and course tools alike.
 
 Every route needs ``Authorization: Bearer <token>``. Instructor routes refuse a student's token
 (403); a student's routes answer only about that student's own variant, and no answer to a
-student ever holds a key. Errors are in the app's one shape; a database that cannot be reached
-is a 503 on field ``database`` that says so.
+student ever holds a key (while a graded part is open its feedback is only the outcome's
+description: app/assignments/service.py `student_feedback`). Errors are in the app's one
+shape; a database that cannot be reached is a 503 on field ``database`` that says so.
 """
 
 from __future__ import annotations
@@ -85,10 +86,12 @@ class Caller:
 
 
 def caller(authorization: Annotated[str | None, Header()] = None) -> Caller:
-    if not authorization or not authorization.startswith("Bearer "):
+    # the scheme's name is case-insensitive (RFC 7235 section 2.1): "bearer", "BEARER" too
+    scheme, _, token = (authorization or "").strip().partition(" ")
+    if scheme.lower() != "bearer" or not token.strip():
         raise fail(401, "authorization", "send 'Authorization: Bearer <token>'")
     try:
-        row = store().token(digest(authorization.removeprefix("Bearer ").strip()))
+        row = store().token(digest(token.strip()))
     except DatabaseUnavailable as exc:
         raise fail(503, "database", f"the assignment database is unreachable ({exc})") from None
     if row is None:
@@ -338,7 +341,10 @@ def get_mine(assignment_id: str, who: Annotated[Caller, Depends(student)]) -> di
     "/{assignment_id}/parts/{part_id}/submit",
     responses={
         **ERRORS,
-        409: {"description": "Closed, or every attempt used (field names which)."},
+        409: {
+            "description": "Closed, every attempt used, or a `request_id` already used for "
+            "another part or answer (the field names which)."
+        },
         429: {"description": "Too many submissions in a minute (field `answer`)."},
     },
     summary="Submit a part's answer",

@@ -279,3 +279,46 @@ def test_a_graded_assignment_shows_only_the_steps_that_give_no_open_part_away():
     assert {"kinematics", "energy"} <= set(shown) and not {"forces", "lagrange"} & set(shown)
     assert "lagrange" in shown_steps("graded", True, parts)  # closed: everything
     assert "lagrange" in shown_steps("practice", False, parts)
+
+
+def test_a_request_id_is_one_submission_of_one_part(client, teacher, deployed):
+    """Hostile play-test, item 2: a request_id reused on another part (or with another answer)
+    answered 200 with the earlier submission of a different part, and the new answer was never
+    stored; now a 409 naming request_id. The same request again is still the same submission."""
+    r = client.post(
+        "/api/v1/assignments/students/tokens", json={"students": ["rid"]}, headers=teacher
+    )
+    headers = {"Authorization": f"Bearer {r.json()['tokens']['rid']}"}
+    url = "/api/v1/assignments/week1/parts/{}/submit"
+    first = client.post(url.format("T"), json={"answer": "1", "request_id": "r1"}, headers=headers)
+    assert first.status_code == 200 and first.json()["part"] == "T"
+    again = client.post(url.format("T"), json={"answer": "1", "request_id": "r1"}, headers=headers)
+    assert again.status_code == 200
+    assert again.json()["submission_id"] == first.json()["submission_id"]
+    for part, answer in (("eom", "1 = 0"), ("T", "2")):
+        r = client.post(
+            url.format(part), json={"answer": answer, "request_id": "r1"}, headers=headers
+        )
+        assert r.status_code == 409, r.text
+        assert r.json()["detail"][0]["field"] == "request_id"
+    mine = client.get("/api/v1/assignments/week1/mine", headers=headers).json()
+    assert {p["id"]: p["attempts_used"] for p in mine["parts"]} == {"T": 1, "eom": 0}
+    # another student may use the same id
+    r = client.post(
+        "/api/v1/assignments/students/tokens", json={"students": ["rid2"]}, headers=teacher
+    )
+    other = {"Authorization": f"Bearer {r.json()['tokens']['rid2']}"}
+    r = client.post(url.format("eom"), json={"answer": "1 = 0", "request_id": "r1"}, headers=other)
+    assert r.status_code == 200 and r.json()["part"] == "eom"
+
+
+def test_the_bearer_scheme_is_case_insensitive(client, pupils, deployed):
+    """Hostile play-test, item 3: RFC 7235 section 2.1 makes the scheme's name case-insensitive."""
+    token = pupils["s1"]["Authorization"].removeprefix("Bearer ")
+    for scheme in ("bearer", "BEARER", "Bearer"):
+        headers = {"Authorization": f"{scheme} {token}"}
+        r = client.get("/api/v1/assignments/week1/mine", headers=headers)
+        assert r.status_code == 200, (scheme, r.text)
+    for bad in (f"Basic {token}", "bearer", "bearer  ", token):
+        r = client.get("/api/v1/assignments/week1/mine", headers={"Authorization": bad})
+        assert r.status_code == 401 and r.json()["detail"][0]["field"] == "authorization"
