@@ -188,3 +188,37 @@ def test_the_full_feedback_is_kept_and_shown_once_the_part_is_closed(client, tea
     (v,) = [p for p in mine["parts"] if p["id"] == "V"]
     key_v = key_expressions(variant, next(p for p in variant.parts if p["id"] == "V"))[0]
     assert any(to_latex(key_v) in line for line in v["last"]["feedback"]), v["last"]
+
+
+def test_practice_mode_keeps_the_full_feedback(client, teacher):
+    """A practice assignment gives away nothing it grades: the checker's words at once."""
+    document = shipped_templates()["pendulum_energies"].model_dump(
+        mode="json", exclude_defaults=True
+    )
+    document |= {"id": "practice_pend", "mode": "practice"}
+    assert client.post(f"{API}/templates", json={"template": document}, headers=teacher).is_success
+    r = client.post(
+        f"{API}/templates/practice_pend/deploy",
+        json={"assignment_id": "practice1", "count": 1},
+        headers=teacher,
+    )
+    variant = Variant.from_json(r.json()["variants"][0]["variant"])
+    key = key_expressions(variant, next(p for p in variant.parts if p["id"] == "T"))[0]
+    headers = pupil(client, teacher, "practiser")
+    r = client.post(f"{API}/practice1/parts/T/submit", json={"answer": "1"}, headers=headers)
+    assert any(to_latex(key) in line for line in r.json()["feedback"]), r.json()
+
+
+def test_the_same_wrong_answer_again_is_no_new_attempt(client, teacher):
+    """Typing an answer again returned the earlier attempt, whose number the one-row-per-attempt
+    index refused a second time: a 409 "being scored" after every renumbering (found by the
+    test above: "0" and "-0" to an equilibrium)."""
+    preview = deploy_graded(client, teacher, "pendulum_energies", max_attempts=3)
+    headers = pupil(client, teacher, "repeater")
+    url = f"{API}/{preview['assignment_id']}/parts/T/submit"
+    for _ in range(2):
+        r = client.post(url, json={"answer": "1"}, headers=headers)
+        assert r.status_code == 200, r.text
+    mine = client.get(f"{API}/{preview['assignment_id']}/mine", headers=headers).json()
+    (t,) = [p for p in mine["parts"] if p["id"] == "T"]
+    assert (t["attempts_used"], t["attempts_left"]) == (1, 2)
