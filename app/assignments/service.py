@@ -250,25 +250,10 @@ def part_closed(template: dict[str, Any], closed: bool, attempts: list, policy: 
     return grading.attempts_left(attempts, policy) == 0
 
 
-def student_feedback(code: str, feedback: list[str]) -> list[str]:
-    """What a student of an open graded part is told: the outcome code's parameter-free
-    description (mechanics/assignments/outcomes.py), and none of the checker's math. Kept: a
-    parse error (it is about the student's own text; the parser never sees the key) and the
-    "Cannot decide, because ..." lines this module and grading.py write (no expression)."""
-    kind = code.split(".", 1)[-1]
-    if kind == outcomes.UNREADABLE:
-        return list(feedback)
-    lines = [outcomes.meaning(code).capitalize() + "."] if code else []
-    lines += [f for f in feedback if f.startswith("Cannot decide, because")]
-    if kind not in outcomes.CREDIT:
-        lines.append("The checker's full feedback is shown once this part is closed.")
-    return lines
-
-
 def _submission_json(row: Any, full: bool = True) -> dict[str, Any]:
     feedback = list(row.feedback or [])
     if not full:
-        feedback = student_feedback(row.code or "", feedback)
+        feedback = outcomes.open_feedback(row.code or "", feedback)
     return {
         "submission_id": row.id,
         "part": row.part,

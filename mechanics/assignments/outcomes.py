@@ -184,6 +184,21 @@ def meaning(code_: str) -> str:
     return row.meaning if row is not None else "not equal to the key"
 
 
+def open_feedback(code_: str, feedback: list[str], note: bool = True) -> list[str]:
+    """What a student of an open graded part is told: the outcome's parameter-free description,
+    and none of the checker's math (its "Missing term ..." is the key). Kept: a parse error (about
+    the student's own text; the parser never sees the key) and the "Cannot decide, because ..."
+    lines grading.py and the app write (no expression)."""
+    kind = code_.split(".", 1)[-1]
+    if kind == UNREADABLE:
+        return list(feedback)
+    lines = [meaning(code_).capitalize() + "."] if code_ else []
+    lines += [f for f in feedback if f.startswith("Cannot decide, because")]
+    if note and kind not in CREDIT:  # (PrairieLearn has its own answer panel: no note)
+        lines.append("The checker's full feedback is shown once this part is closed.")
+    return lines
+
+
 def table() -> list[dict[str, str]]:
     """The documented table: kind, meaning, whether it scores the part in full."""
     rows = [{"kind": k.name, "meaning": k.meaning, "full_credit": k.credit} for k in KINDS]

@@ -4,7 +4,8 @@ The directory holds ``info.json``, ``question.html`` (a ``pl-string-input`` per 
 ``server.py``, whose ``generate(data)`` builds the variant from ``data["variant_seed"]`` (the same
 variant as Lagrange Lab's for that seed) and refuses one whose keys the second route cannot
 verify, and whose ``grade(data)`` fills ``data["partial_scores"]`` with the checker's scores and
-feedback. An answer that does not parse, or that the checker cannot decide, is a format error:
+feedback (a graded template's: only the outcome's description, since the checker's words name
+the key). An answer that does not parse, or that the checker cannot decide, is a format error:
 PrairieLearn then neither grades it nor counts it. The question imports this engine as a library
 (``pip install lagrange-lab`` in the course's Python image); it needs no network.
 """

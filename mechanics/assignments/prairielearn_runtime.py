@@ -42,6 +42,9 @@ def grade_question(template_document: dict[str, Any], data: dict[str, Any]) -> N
     """Each part judged by the checker: its score (partial credit by outcome code) and its
     feedback in ``partial_scores``; unreadable or undecidable answers are format errors."""
     variant = Variant.from_json(data["params"]["variant"])
+    # graded: PrairieLearn shows the feedback after every try, and the checker's words name the
+    # key ("Missing term ..."): only the outcome's description, as the app gives an open part
+    graded = template_document.get("mode", "graded") == "graded"
     total = weights = 0.0
     for part in variant.parts:
         name = part["id"]
@@ -52,8 +55,11 @@ def grade_question(template_document: dict[str, Any], data: dict[str, Any]) -> N
             data["partial_scores"].pop(name, None)  # the element's own exact-match grade
             continue
         judged = grading.judge(variant, part, answer)
+        feedback = list(judged.feedback)
+        if graded and judged.code.split(".", 1)[1] not in outcomes.CREDIT:
+            feedback = outcomes.open_feedback(judged.code, feedback, note=False)
         if not judged.decided:
-            data["format_errors"][name] = " ".join(judged.feedback)
+            data["format_errors"][name] = " ".join(feedback)
             data["partial_scores"].pop(name, None)
             continue
         kind = judged.code.split(".", 1)[1]
@@ -61,7 +67,7 @@ def grade_question(template_document: dict[str, Any], data: dict[str, Any]) -> N
         data["partial_scores"][name] = {
             "score": score,
             "weight": part["weight"],
-            "feedback": f"{judged.code}: " + " ".join(judged.feedback),
+            "feedback": f"{judged.code}: " + " ".join(feedback),
         }
         total += part["weight"] * score
     data["score"] = total / weights if weights else 0.0

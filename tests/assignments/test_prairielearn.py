@@ -97,3 +97,17 @@ def test_unreadable_and_undecidable_answers_are_format_errors(question):
     out = graded(server, data, {"T": "(theta_dot", "V": "", "L": "x"})
     assert set(out["format_errors"]) >= {"T", "V"}
     assert "T" not in out["partial_scores"]
+
+
+def test_a_graded_questions_feedback_holds_no_key(question):
+    """Hostile play-test, item 1: PrairieLearn shows the grader's feedback after every try, and
+    the checker's "Missing term $\\frac{...}$" to an answer "1" was the key. A graded template's
+    question says only the outcome's description: no math at all."""
+    _, server = question
+    data = generated(server, 7)
+    out = graded(server, data, {"T": "1", "V": "0", "L": "1", "eom": "1 = 0"})
+    for name, result in out["partial_scores"].items():
+        assert result["score"] == 0.0
+        assert "$" not in result["feedback"], result
+        assert data["correct_answers"][name] not in result["feedback"]
+    assert out["partial_scores"]["T"]["feedback"] == "T.missing_term: A term is missing."
