@@ -19,7 +19,7 @@ import math
 import re
 
 import pytest
-from test_equilibria_math import RESULTS, named_e_and_q, words_and_math
+from test_equilibria_math import NAMES, named_e_and_q, result_of, words_and_math
 from test_equilibria_nc import cubic, trap
 
 from mechanics.derive import derivation_of_scene, derive_model
@@ -65,7 +65,8 @@ def test_the_stability_step_writes_the_matrices_as_the_matrix_step_does():
     _, maths = words_and_math(stability["text"])
     assert r"\mathbf M\,\delta\ddot q + \mathbf C\,\delta\dot q + \mathbf K\,\delta q = 0" in maths
     assert not any(bare_matrix(tex) for tex in maths), maths
-    for name, result in RESULTS.items():
+    for name in NAMES:
+        result = result_of(name)
         for e in result["equilibria"]:
             _, maths = words_and_math(e["reason"])
             assert not any(bare_matrix(tex) for tex in maths), (name, e["reason"])
