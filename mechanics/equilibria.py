@@ -1982,6 +1982,7 @@ def _judged(m, M, C, K, n_free, idx, free, power, report):
     kind, reason = flat.amend(
         kind, reason, report, latex_names, shown, single, _potential(_turning(m))
     )
+    kind, reason = stability.drifting(kind, reason, n_free)  # on a set: neutral, not stable
     if report and report.level:  # the zero modes are a family's, not (only) free coordinates'
         reason = reason.replace("free direction(s)", "free or family direction(s)")
     return kind, reason, lam, vecs
@@ -2468,7 +2469,7 @@ def _classify(M, C, K, n_free, names, *, turning: str = "", power: Power = Power
         )
     free_note = (
         "; the zero eigenvalues belong to the free direction(s), along which the system stays "
-        "where it is put (a family of equilibria) and a nudge drifts on (neutral)"
+        "where it is put (a family of equilibria), and a nudge in velocity along them drifts on"
         if np.any(zero)
         else ""
     )

@@ -32,6 +32,41 @@ def _distances(places: dict[str, np.ndarray]) -> tuple[float, ...]:
     )
 
 
+def _orientation(places: dict[str, np.ndarray]) -> tuple[float, ...]:
+    """What a mirror image changes and a proper motion (determinant +1) keeps: in a plane
+    z = const the signed area of every triple, in space the triple product of every quadruple.
+    Distances alone merged the two cyclic orders of three beads on a ring, mirror images that
+    no turn of the ring carries into one another: two circles of equilibria, not one (issue 25,
+    item 1). A leading 0/1 keeps a planar key from being compared with a spatial one."""
+    names = sorted(places)
+    p = [places[n] for n in names]
+    if len({round(float(x[2]), 12) for x in p}) <= 1:
+        return (0.0,) + tuple(
+            float(np.cross(p[j][:2] - p[i][:2], p[k][:2] - p[i][:2]))
+            for i in range(len(p))
+            for j in range(i + 1, len(p))
+            for k in range(j + 1, len(p))
+        )
+    return (1.0,) + tuple(
+        float(np.dot(p[j] - p[i], np.cross(p[k] - p[i], p[l] - p[i])))
+        for i in range(len(p))
+        for j in range(i + 1, len(p))
+        for k in range(j + 1, len(p))
+        for l in range(k + 1, len(p))  # noqa: E741
+    )
+
+
+def _key(places: dict[str, np.ndarray]) -> tuple[float, ...]:
+    """Equal keys: the two configurations are congruent by a proper motion (same distances,
+    same orientation), each of the other."""
+    return _distances(places) + _orientation(places)
+
+
+def _number(x: float, scale: float) -> str:
+    """A length as read: round-off beside the scene's size (3.7e-16 of a distance 2) is 0."""
+    return "0" if abs(x) <= 1e-9 * max(scale, 1.0) else f"{x:.4g}"
+
+
 def _moving(m: Any, members: list[dict[str, np.ndarray]]) -> list[str]:
     """The places that are not at one spot over the members (the bodies the family moves)."""
     first = members[0]
@@ -46,30 +81,70 @@ def _moving(m: Any, members: list[dict[str, np.ndarray]]) -> list[str]:
 
 
 def describe(m: Any, dim: int, members: list[dict[str, np.ndarray]]) -> str:
-    """The family in words: a circle or sphere about a fixed point where one particle moves
-    alone at a fixed distance from it, otherwise what stays fixed along it."""
+    """The family in words, saying only what the members found show: a circle or sphere about
+    a fixed point (or a centre) where one particle moves alone at a fixed distance from it; the
+    distances and orientation that stay where several bodies move (each member is a proper
+    motion of the listed one); otherwise the points found. No symmetry of the scene is claimed
+    that is not shown (a particle in the trough y = x² has none: issue 25, item 2)."""
     moving = _moving(m, members) if len(members) > 1 else []
     first = members[0]
     fixed = [n for n in sorted(first) if n not in moving]
-    if len(moving) == 1 and fixed and dim in (1, 2):
+    shape = "circle" if dim == 1 else "sphere"
+    if len(moving) == 1 and dim in (1, 2):
         body = moving[0]
         for c in fixed:
             radius = [float(np.linalg.norm(p[body] - p[c])) for p in members]
             if max(radius) - min(radius) <= _SAME * max(1.0, max(radius)):
-                shape = "circle" if dim == 1 else "sphere"
                 return f"a {shape} of radius {radius[0]:.4g} about {c}, on which {body} rests"
-    names = sorted(first)
-    kept = [
-        f"|{a} − {b}| = {np.linalg.norm(first[a] - first[b]):.4g}"
-        for i, a in enumerate(names)
-        for b in names[:i]
-        if a in moving or b in moving
-    ]
+        fit = _circle([p[body] for p in members]) if dim == 1 else None
+        if fit is not None:
+            centre, radius = fit
+            at = ", ".join(_number(float(x), radius) for x in centre)
+            return (
+                f"a circle of radius {radius:.4g} about the point ({at}), on which {body} rests "
+                "(the members found are turned into one another about that centre)"
+            )
+    if len(moving) > 1:
+        names = sorted(first)
+        scale = max(_distances(first), default=1.0)
+        kept = [
+            f"|{a} − {b}| = {_number(float(np.linalg.norm(first[a] - first[b])), scale)}"
+            for i, a in enumerate(names)
+            for b in names[:i]
+            if a in moving or b in moving
+        ]
+        return (
+            "the configurations with the same distances"
+            + (f" ({', '.join(kept[:4])})" if kept else "")
+            + " and the same orientation (no mirror image among them): each member found is "
+            "the listed one turned, moved, or both"
+        )
+    places = [p[n] for p in members[:3] for n in moving[:1]]
+    shown = ", ".join(f"({', '.join(f'{x:.3g}' for x in r + 0.0)})" for r in places)
+    more = ", …" if len(members) > 3 else ""
+    what = {1: "a curve", 2: "a surface"}.get(dim, "a set")
+    who = f"{moving[0]} at " if moving else ""
     return (
-        "the configurations with the same distances"
-        + (f" ({', '.join(kept[:4])})" if kept else "")
-        + ", which the scene's symmetry (moving or turning the whole) carries into one another"
+        f"{what} through the points found ({who}{shown}{more}); no symmetry of the scene is "
+        "shown to carry them into one another, so its shape is known from those points only"
     )
+
+
+def _circle(points: list[np.ndarray]) -> tuple[np.ndarray, float] | None:
+    """Centre and radius of the circle in a plane z = const through the points, when they lie
+    on one (to ``_SAME``): the ring trough's members, about a centre no named point marks."""
+    if len(points) < 4 or len({round(float(p[2]), 12) for p in points}) > 1:
+        return None
+    xy = np.array([p[:2] for p in points])
+    A = np.column_stack([2 * xy, np.ones(len(xy))])
+    b = np.sum(xy**2, axis=1)
+    sol, *_ = np.linalg.lstsq(A, b, rcond=None)
+    centre = sol[:2]
+    radius = float(np.sqrt(max(sol[2] + centre @ centre, 0.0)))
+    spread = np.linalg.norm(xy - centre, axis=1)
+    if radius <= 0 or np.max(np.abs(spread - radius)) > _SAME * max(1.0, radius):
+        return None
+    return np.array([*centre, points[0][2]]), radius
 
 
 class Continua:
@@ -111,17 +186,19 @@ class Continua:
         places = self._places(q0)
         if places is None:
             return False
-        key = _distances(places)
+        key = _key(places)
         for gkey, _, spots in self.groups:
             scale = max(1.0, *map(abs, gkey), *map(abs, key)) if key else 1.0
-            if all(abs(a - b) <= _SAME * scale for a, b in zip(gkey, key, strict=True)):
+            if len(gkey) == len(key) and all(
+                abs(a - b) <= _SAME * scale for a, b in zip(gkey, key, strict=True)
+            ):
                 spots.append(places)
                 return True
         return False
 
     def add(self, q0: list[float], verdict: Any, result: dict) -> None:
         if verdict.family_dim and (places := self._places(q0)) is not None:
-            self.groups.append((_distances(places), result, [places]))
+            self.groups.append((_key(places), result, [places]))
 
     def describe(self, results: list[dict], verdicts: list) -> None:
         """The family sentence on each listed member's verdict (said once, in the warnings)."""

@@ -159,3 +159,18 @@ def _judge(values: dict[float, float], length: float, kappa: float) -> Flat:
         return Flat("rises", order)
     falling = [sign for sign, rising in sides.items() if not rising]
     return Flat("falls", order, falling[0] if len(falling) == 1 else 0)
+
+
+def drifting(kind: str, reason: str, n_free: int) -> tuple[str, str]:
+    """The verdict of a point on a set of equilibria (free coordinates, or a family): a nudge
+    in velocity along the set carries the system along it for ever, so the point is not
+    Lyapunov stable, however firmly the set holds it. 'stable' with "a nudge drifts on" beside
+    it was a boolean that contradicted its sentence (issue 25, item 3): such a point is
+    'marginal' (neutral), and the sentence says the set is what stays stable."""
+    if kind != "stable" or not n_free:
+        return kind, reason
+    return "marginal", reason + (
+        ": the set of equilibria through this point is stable (a nudge stays near it), but "
+        "the point itself is not, since a nudge along the set carries the system away along it "
+        "for ever: neutral (marginal), not stable"
+    )

@@ -274,7 +274,9 @@ def test_the_top_at_rest_falls_upright_and_swings_hanging(parameters):
         assert "pole of the coordinates" in e["reason"]
         hanging = abs(e["q"]["th"]) > 1
         if hanging:
-            assert e["kind"] == "stable", e["reason"]
+            assert e["kind"] == "marginal" and not e["stable"], e[
+                "reason"
+            ]  # free φ drifts: neutral (issue 25)
             assert e["frequencies"] == pytest.approx([math.sqrt(omega2)] * 2, rel=1e-9)
         else:
             assert e["kind"] == "unstable"
@@ -314,7 +316,8 @@ def test_a_top_with_its_centre_of_mass_off_the_axis_rests_only_with_it_plumb_bel
             I_uw, I_ww = a * h * (I1 - I3) / d**2, (I1 * a**2 + I3 * h**2) / d**2
             inertias = [I1 + m * d**2, I_uu - I_uw**2 / I_ww]
             expected = sorted(math.sqrt(m * g * d / i) for i in inertias)
-            assert e["kind"] == "stable" and e["frequencies"] == pytest.approx(expected)
+            assert e["kind"] == "marginal"  # free φ drifts: neutral (issue 25)
+            assert e["frequencies"] == pytest.approx(expected)
         else:
             assert e["kind"] == "unstable"
     assert any("pole of the coordinates" in w for w in result["warnings"])

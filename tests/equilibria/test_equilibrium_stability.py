@@ -164,6 +164,7 @@ def consistent(out: dict) -> None:
         assert e["stable"] == (e["kind"] in STABLE_KINDS)
         if e["stable"]:
             assert "cannot decide" not in e["reason"]
+            assert "drifts" not in e["reason"]  # a drift along a set is no Lyapunov stability
 
 
 def test_a_free_pair_is_one_continuum_never_unstable_by_round_off():
@@ -173,7 +174,8 @@ def test_a_free_pair_is_one_continuum_never_unstable_by_round_off():
     [e] = out["equilibria"]
     q = e["q"]
     assert math.hypot(q["x2"] - q["x1"], q["y2"] - q["y1"]) == pytest.approx(1.0, abs=1e-9)
-    assert e["kind"] == "stable" and "e^{" not in e["reason"]
+    assert e["kind"] == "marginal" and not e["stable"] and "e^{" not in e["reason"]
+    assert "set of equilibria through this point is stable" in e["reason"]
     assert e["frequencies"] == pytest.approx([math.sqrt(10.0 * 1.5)], rel=1e-9)
     assert sorted(abs(complex(*z)) for z in e["eigenvalues"])[:6] == [0.0] * 6
     assert any("dimension 3" in w for w in out["warnings"])
@@ -272,3 +274,41 @@ def test_at_the_critical_spin_the_conserved_quantity_is_the_jacobi_integral_not_
     assert "E = T + V$ is not" in e["reason"]
     plain = at(equilibria(derive_model(across_two_springs("d"))), y=0.0)
     assert "$E = T + V$ cannot carry" in plain["reason"] and "Jacobi" not in plain["reason"]
+
+
+CART = {
+    "title": "pendulum on a free cart",
+    "coordinates": ["x", "th"],
+    "parameters": {"m1": 2.0, "m2": 1.0, "l": 1.0, "g": 9.81},
+    "bodies": [
+        {"name": "cart", "mass": "m1", "position": ["x", 0, 0]},
+        {"name": "bob", "mass": "m2", "position": ["x + l*sin(th)", "-l*cos(th)", 0]},
+    ],
+    "gravity": {"acceleration": "g", "direction": [0, -1, 0]},
+}
+
+
+def test_a_pendulum_on_a_free_cart_hangs_neutral_not_stable():
+    """Issue 25, item 3. At θ = 0 every x rests: K = diag(0, m₂ g l), M = [[m₁ + m₂, m₂ l],
+    [m₂ l, m₂ l²]], so det(K − ω² M) = 0 gives ω² = g (m₁ + m₂)/(m₁ l) = 14.715 besides ω = 0.
+    A nudge in ẋ carries the cart off for ever (p_x = const), so the point is not Lyapunov
+    stable: marginal with stable false, and the sentence says the set (θ = 0, any x) is what
+    stays stable. θ = π is a maximum across: unstable."""
+    out = equilibria(derive_model(CART))
+    consistent(out)
+    hanging = at(out, th=0.0)
+    assert hanging["free"] == ["x"]
+    assert hanging["kind"] == "marginal" and hanging["stable"] is False
+    assert "set of equilibria through this point is stable" in hanging["reason"]
+    assert "not stable" in hanging["reason"]
+    assert hanging["frequencies"] == pytest.approx([math.sqrt(9.81 * 3.0 / 2.0)], rel=1e-9)
+    upright = next(e for e in out["equilibria"] if abs(abs(e["q"]["th"]) - math.pi) < 1e-6)
+    assert upright["kind"] == "unstable"
+
+
+def test_an_isolated_minimum_keeps_its_stable_verdict():
+    """No free coordinate and no family: the drift clause never applies (the pure function)."""
+    assert stability.drifting("stable", "minimum", 0) == ("stable", "minimum")
+    kind, reason = stability.drifting("stable", "minimum", 1)
+    assert kind == "marginal" and reason.startswith("minimum") and "not stable" in reason
+    assert stability.drifting("unstable", "maximum", 2) == ("unstable", "maximum")
