@@ -1,6 +1,8 @@
 """sympy's own LagrangesMethod/KanesMethod on a scene's bodies: the independent reference.
 
-Tests compare the engine's equations with these, and the derive benchmark times them side by side.
+Tests compare the engine's equations with these, the derive benchmark times them side by side, and
+an assignment's keys are checked against them before a student sees a variant
+(mechanics/assignments/second_route.py).
 The oracle shares only the bodies and the declared loads with the engine; it forms V from the
 spec's fields, and the Lagrangian, partial velocities and generalized forces its own (sympy's) way.
 """
