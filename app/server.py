@@ -171,9 +171,17 @@ def _guarded(cls: type) -> None:
             guard.lost()
         lost(self, exc)
 
+    def send_400_response(self: Any, msg: str) -> None:
+        """uvicorn's own answer to a request it cannot parse (a negative or huge Content-Length,
+        two of them, a NUL in a header) was plain text: it is the one error shape too."""
+        guard = getattr(self, "_lagrange_lab_guard", None) or _Guard(self, self.transport)
+        guard.refuse(400, "Bad Request", "request", f"malformed HTTP request ({msg.rstrip('.')})")
+
     cls.connection_made = connection_made
     cls.data_received = data_received
     cls.connection_lost = connection_lost
+    if hasattr(cls, "send_400_response"):
+        cls.send_400_response = send_400_response
     cls._lagrange_lab_guarded = True
 
 

@@ -143,6 +143,29 @@ def test_headers_past_the_limit_are_a_431_read_no_further(server):
     assert _get(port, b"X-Fine: " + b"b" * 8000 + b"\r\n").startswith(b"HTTP/1.1 200")
 
 
+@pytest.mark.parametrize(
+    "framing",
+    [
+        b"Content-Length: -5\r\n",
+        b"Content-Length: 99999999999999999999\r\n",
+        b"Content-Length: 3\r\nContent-Length: 4\r\n",
+        b"X-Nul: a\x00b\r\n",
+    ],
+)
+def test_a_request_the_server_cannot_parse_is_a_400_in_the_one_error_shape(server, framing):
+    """Hostile play-test (2026-12-02): uvicorn answered these with a plain-text 'Invalid HTTP
+    request received.'; every error a client can get is the JSON shape naming its field."""
+    port, _ = server
+    with _connect(port) as s:
+        s.sendall(b"POST /api/v1/derive HTTP/1.1\r\nHost: test\r\n" + framing + b"\r\nabc")
+        answer = _read_all(s, 10)
+    head, _, body = answer.partition(b"\r\n\r\n")
+    assert head.startswith(b"HTTP/1.1 400"), answer
+    assert b"application/json" in head.lower()
+    assert json.loads(body)["detail"][0]["field"] == "request"
+    assert _get(port).startswith(b"HTTP/1.1 200")
+
+
 def test_a_body_that_trickles_is_a_408_and_the_connection_closes(server):
     port, _ = server
     with _connect(port) as s:
