@@ -94,6 +94,8 @@ def decode_state(token: str) -> dict[str, Any]:
         raise ShareError(f"the token's state is larger than {MAX_JSON} bytes")
     if not inflate.eof:
         raise ShareError("not a share token: its compressed data is cut short")
+    if inflate.unused_data:  # one state, one token: trailing bytes would be new cache keys
+        raise ShareError("not a share token: it goes on after its compressed data")
     # said in words about the token, not Python's ('Expecting value: line 1 column 6 (char 5)',
     # 'maximum recursion depth exceeded while decoding a JSON array from a unicode string')
     try:

@@ -161,3 +161,15 @@ def test_posting_a_state_checks_it_like_any_request():
     assert r.status_code == 422
     r = client.post("/api/v1/export/share", json={"parameters": {}})
     assert r.status_code == 422 and r.json()["detail"][0]["field"] == "scene_id"
+
+
+def test_a_token_with_bytes_after_its_state_is_refused():
+    """Hostile play-test (2026-12-02): bytes after the compressed state were ignored, so
+    'token' + 'AAAA', 'AAAB', ... opened the same state under ever new keys of the links' memo."""
+    token = encode_state({"scene_id": "simple_pendulum"})
+    assert decode_state(token) == {"scene_id": "simple_pendulum"}
+    with pytest.raises(ShareError, match="goes on after"):
+        decode_state(token + "AAAA")
+    r = TestClient(app).get(f"/api/v1/export/share/{token}AAAA")
+    assert r.status_code == 422
+    assert r.json()["detail"][0]["field"] == "token"
