@@ -369,8 +369,8 @@ async def post_spec(
     format: Annotated[SpecFormat, Query(description="toml or json")] = "toml",
 ) -> Response:
     """The spec of a built-in scene (as written in its file) or a posted one (as its schema read
-    it, defaults left out; names and physics are checked by /derive, so a draft can be saved), as TOML (`tomllib` reads it back equal) or JSON: ready to edit and post
-    to `/api/v1/derive`."""
+    it, defaults left out; names and physics are checked by /derive, so a draft can be saved),
+    as TOML (`tomllib` reads it back equal) or JSON: ready to edit and post to `/api/v1/derive`."""
     _only_query(http, ("format",), "this export reads format (toml or json) only")
     if request.scene_id is not None:
         return _spec_file(_builtin_spec(request.scene_id), format, request.scene_id)
