@@ -299,6 +299,10 @@ def first_stop(
     else:
         return None
     found = _locate(c, t0, y0, t1, params, req)
+    if found is None and first is not None and first.kind == "anchor":
+        # a spring's length |d| touches 0 and grows again (a body through its anchor in a
+        # plane): no sign change for the event search, so step the interval again, watched
+        found = _domain_end(c, params, run, t0, y0, t1, kind="anchor")
     if found is None and first is not None:  # not located: the condition became undefined
         found = first, *_first_undefined(c, first, params, t0, y0, t1)
     if found is None and run.status != "ok":  # a fixed step may land past a domain's end
@@ -309,12 +313,22 @@ def first_stop(
     return _cut(run, k, stop, t_stop, y_stop)
 
 
-def _domain_end(c: CompiledScene, params: list[float], run: Any, t0, y0: np.ndarray, t1: float):
+def _domain_end(
+    c: CompiledScene,
+    params: list[float],
+    run: Any,
+    t0,
+    y0: np.ndarray,
+    t1: float,
+    kind: str = "domain",
+):
     """A domain's end in (t0, t1] that a run ending early there did not see: its steps (a fixed
     step of rk4) landed past it, where the right-hand side is NaN, and a tangential approach
     (x = l sin√θ touches θ = 0) changes no sign for the event search. Stepped again, tightly and
-    watched, the steps creep into it as `StopWatch` expects."""
-    if not any(stop.kind == "domain" for stop in c.stops) or not t1 > t0:
+    watched, the steps creep into it as `StopWatch` expects. The same for a spring's length
+    that touches 0 between two samples of a run that was not watched (the C loop's):
+    ``kind="anchor"``."""
+    if not any(stop.kind == kind for stop in c.stops) or not t1 > t0:
         return None
     watch = StopWatch(c, params, np.asarray(y0, dtype=float))
     watch.last = (t0, np.array(y0, dtype=float), watch._values(t0, np.asarray(y0)))
@@ -337,7 +351,7 @@ def _domain_end(c: CompiledScene, params: list[float], run: Any, t0, y0: np.ndar
             )
     except (ValueError, *_PHYSICAL):
         return None
-    if watch.hit is None or c.stops[watch.hit[0]].kind != "domain":
+    if watch.hit is None or c.stops[watch.hit[0]].kind != kind:
         return None
     return watch.secant(params)
 

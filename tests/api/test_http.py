@@ -288,16 +288,16 @@ def _post_chunked(port: int, mib: int) -> tuple[bytes, int]:
             b"Transfer-Encoding: chunked\r\n\r\n"
         )
         s.setblocking(False)
-        sent, answer, deadline = 0, b"", time.monotonic() + 30
+        sent, answer, deadline, sending = 0, b"", time.monotonic() + 30, True
         while time.monotonic() < deadline and not answer.endswith(b"}"):
-            if sent < mib * 1024 * 1024 and b"\r\n\r\n" not in answer:
+            if sending and sent < mib * 1024 * 1024 and b"\r\n\r\n" not in answer:
                 try:
                     s.send(b"%x\r\n%s\r\n" % (len(chunk), chunk))
                     sent += len(chunk)
                 except BlockingIOError:
                     pass
-                except OSError:
-                    break
+                except OSError:  # the server closed its side: stop sending, read its answer
+                    sending = False
             try:
                 data = s.recv(65536)
                 if not data:

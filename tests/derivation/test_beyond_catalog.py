@@ -681,7 +681,7 @@ _DERIVE = (
 @pytest.mark.slow
 @pytest.mark.parametrize("sid", ["turntable_springs_rest_length", "spring_chain_between_walls"])
 def test_derivation_is_the_same_under_any_hash_seed(sid):
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     outputs = []
     for seed in ("1", "2"):
         env = {**os.environ, "PYTHONHASHSEED": seed}

@@ -69,6 +69,7 @@ def installed(tmp_path_factory) -> str:
     where = subprocess.run(
         [python, "-c", "import app.paths as p; print(p.TEMPLATES_DIR); print(p.STATIC_DIR)"],
         cwd=home,
+        env={**os.environ, "PYTHONPATH": ""},  # a checkout on the path is not what is installed
         capture_output=True,
         text=True,
         check=True,

@@ -106,7 +106,7 @@ def test_a_scene_run_through_the_integrator_leaves_the_gil_free():
         out = integrate(
             c.rhs(params),
             y0,
-            np.linspace(0.0, 3000.0, 5),
+            np.linspace(0.0, 30000.0, 5),  # long enough to tell under any load
             method="dop853_c",
             rtol=1e-13,
             atol=1e-13,
