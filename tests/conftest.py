@@ -57,7 +57,7 @@ SERIAL = (
     "tests/numerics/test_fixed_step.py::test_a_finite_time_blow_up_is_told_as_one",
     "tests/api/test_api.py::test_a_100_kb_expression_is_refused_fast",
     "tests/numerics/test_integrators.py::test_stiff_linear_problem_is_solved_quickly",
-    "tests/answers/test_check_trust.py::"
+    "tests/answers/test_check_proofs.py::"
     "test_an_undecidable_hostile_answer_is_refused_a_proof_quickly",
     "tests/browser/test_live.py::test_a_drag_keeps_sixty_frames_a_second",
     "tests/browser/test_live.py::test_a_slider_input_is_drawn_within_a_few_frames",

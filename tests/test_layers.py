@@ -119,15 +119,7 @@ ALLOWED_UNEXPLAINED: set[str] = {
     "stops",
 }
 #: Test files still named after a review round.
-ALLOWED_ROUND_NAMES: set[str] = {
-    "tests/answers/test_check_feedback4.py",
-    "tests/answers/test_check_feedback5.py",
-    "tests/answers/test_check_trust.py",
-    "tests/equilibria/test_equilibria_text3.py",
-    "tests/equilibria/test_equilibria_trust.py",
-    "tests/equilibria/test_equilibria_trust5.py",
-    "tests/export/test_share_trust.py",
-}
+ALLOWED_ROUND_NAMES: set[str] = set()
 # fmt: on
 
 ROUND_NAME = re.compile(r"([0-9]|trust|round|leftover|polish)")

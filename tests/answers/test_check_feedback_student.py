@@ -95,7 +95,7 @@ def test_a_q_with_the_conservative_part_says_so(scene, coordinate, nonconservati
 def test_a_q_wrong_otherwise_is_not_said_to_hold_the_conservative_part():
     V, symbols = potential_from_file("rolling_disk")
     conservative = -sp.diff(V, symbols["x"])
-    # (−(−∂V/∂x), the part with its sign flipped, is named as such: test_check_feedback4)
+    # (−(−∂V/∂x), the part with its sign flipped, is named as such: test_check_feedback_your_turn)
     for answer in (f"2*({sp.sstr(conservative)})", "m*g"):
         v = verdict("rolling_disk", "Q", answer, "x")
         assert v.correct is False
@@ -118,7 +118,7 @@ def test_a_constant_that_is_no_energy_is_a_unit_error_in_t_v_and_l(quantity, add
     right = RIGHT[quantity]
     v = verdict("simple_pendulum", quantity, f"{right} + {added}")
     assert v.correct is False, v.feedback
-    said = ("units", "a pure number")  # a bare 5 is named a pure number (test_check_feedback4)
+    said = ("units", "a pure number")  # a bare 5: a pure number (test_check_feedback_your_turn)
     assert any(any(w in line for w in said) and "not an energy" in line for line in v.feedback), (
         v.feedback
     )
