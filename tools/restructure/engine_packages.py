@@ -6,7 +6,6 @@ engine file moves), then the suite:
 
     python tools/restructure/engine_packages.py     # git mv + rewrite of names and paths
     python tools/restructure/facade.py              # optional: app/ through mechanics/api.py
-    cp tools/restructure/test_layers_after.py tests/test_layers.py   # the rules for packages
     python -m pytest -n 2
 
 What it does: `MOVES` maps each flat module to its stage package (a module that is not in it is
@@ -16,8 +15,10 @@ reported and left where it is: add it); files move with `git mv`; every dotted n
 code hash and the wheel's package list are fixed by hand (`post_edits`); ruff fixes the import
 order; prose lines the longer names pushed past 100 columns are rewrapped, and code lines that did
 are listed for a hand fix. Tried on 2026-12-02 against main: 48 modules moved, the whole suite
-collected (3365 tests) and a sample of 888 passed. Then regenerate test_layers' allow-lists and
-swap README's layout section for readme_layout_after.md.
+collected (3365 tests) and a sample of 888 passed. tests/test_layers.py then reads a module's
+stage from its package (`layers_by_package`); its allow-lists still name the flat modules, so
+write them again with the new names, and swap README's layout section for
+readme_layout_after.md.
 """
 
 from __future__ import annotations
@@ -221,6 +222,26 @@ def rewrite_all() -> None:
             path.write_text(new)
 
 
+def layers_by_package() -> None:
+    """tests/test_layers.py placed each flat module by a `STAGE` table; in packages a module's
+    stage is its package's name, so the table goes and `_stage` reads the name."""
+    path = ROOT / "tests" / "test_layers.py"
+    text = path.read_text()
+    start = text.index("#: Today's flat modules")
+    end = text.index("# fmt: off")
+    text = (
+        text[:start]
+        + "#: Every engine module lives in the package of its stage (mechanics/<stage>/...).\n"
+        + 'STAGES = {*ORDER, *SIBLINGS} - {"run"}\n\n\n'
+        + text[end:]
+    )
+    text = text.replace(
+        '    return STAGE.get(name.split(".")[0])',
+        '    first = name.split(".")[0]\n    return first if first in STAGES else None',
+    )
+    path.write_text(text)
+
+
 def post_edits() -> None:
     """What a rewrite of names cannot do: paths computed from __file__, the wheel's package list."""
     cache = M / "serving" / "cache.py"
@@ -310,6 +331,7 @@ if __name__ == "__main__":
     done = move_files()
     rewrite_all()
     post_edits()
+    layers_by_package()
     subprocess.run(["ruff", "check", "--fix", "-q", "."], cwd=ROOT)
     subprocess.run(["ruff", "format", "-q", "."], cwd=ROOT)
     for where in wrap_long_lines():
